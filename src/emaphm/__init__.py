@@ -1,0 +1,55 @@
+"""emaphm: model-based prognostics and health management of PMSM-driven electromechanical actuators.
+
+The public API:
+
+- `simulate` runs the high-fidelity twin (DESIGN §3) for a fault vector and returns a `SimResult`;
+- `HighFidelityEma` is the twin itself; `EmaParams` and its groups hold the parameters;
+- `FAULT_NAMES`, `HEALTHY`, `TABLE1_REFERENCE`, `as_fault_vector`, `apply_faults` define the
+  fault vector k1..k8 (DESIGN §2);
+- `Chirp`, `Step`, `Ramp`, `Sine` are position commands;
+- `read_trace` / `write_trace` store traces as HDF5 or CSV.
+"""
+
+from ._version import __version__
+from .commands import Chirp, Ramp, Sine, Step, make_command
+from .errors import InputError
+from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
+from .io import read_trace, write_trace
+from .models import HighFidelityEma, simulate
+from .params import (
+    ControllerParams,
+    EmaParams,
+    IntegrationParams,
+    InverterParams,
+    MotorParams,
+    SensorParams,
+    TransmissionParams,
+)
+from .results import SimResult
+
+__all__ = [
+    "FAULT_NAMES",
+    "HEALTHY",
+    "TABLE1_REFERENCE",
+    "Chirp",
+    "ControllerParams",
+    "EmaParams",
+    "HighFidelityEma",
+    "InputError",
+    "IntegrationParams",
+    "InverterParams",
+    "MotorParams",
+    "Ramp",
+    "SensorParams",
+    "SimResult",
+    "Sine",
+    "Step",
+    "TransmissionParams",
+    "__version__",
+    "apply_faults",
+    "as_fault_vector",
+    "make_command",
+    "read_trace",
+    "simulate",
+    "write_trace",
+]

@@ -1,0 +1,128 @@
+"""Position command profiles θ_cmd(t) on the user (surface) side [rad].
+
+`Chirp` is the FDI test manoeuvre of DESIGN §6/§7 and the default; `Step`, `Ramp` and `Sine` are
+for exploring the model. Every command is a frozen dataclass with a `duration` [s] and is called
+on an array of times [s] to give θ_cmd [rad].
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+
+__all__ = ["COMMANDS", "Chirp", "Command", "Ramp", "Sine", "Step", "make_command"]
+
+
+class Command(Protocol):
+    """A position command: ``command(t)`` gives θ_cmd [rad] at times t [s]."""
+
+    duration: float
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]: ...
+
+
+class _Checked:
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            v = getattr(self, f.name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise InputError(f"{type(self).__name__}.{f.name} must be a finite number, got {v!r}")
+            if f.name in ("duration", "T", "V_max", "f0", "f1", "frequency") and v <= 0:
+                raise InputError(f"{type(self).__name__}.{f.name} must be > 0, got {v!r}")
+            if f.name in ("t_f", "t_0", "A_max") and v < 0:
+                raise InputError(f"{type(self).__name__}.{f.name} must be >= 0, got {v!r}")
+
+
+@dataclass(frozen=True)
+class Chirp(_Checked):
+    """Velocity-limited chirp with a raised-cosine fade-in (DESIGN §7).
+
+    θ_cmd = w(t)·A(t)·sin φ(t), φ(t) = 2π(f0·t + (f1 − f0)·t²/(2T)), f(t) = f0 + (f1 − f0)·t/T,
+    A(t) = min(A_max, V_max/(2π·f(t))), w(t) = ½(1 − cos(π·t/t_f)) for t < t_f, then 1.
+
+    A_max : float  largest amplitude [rad]
+    V_max : float  velocity limit that caps the amplitude at high frequency [rad/s]
+    f0, f1 : float  start and end frequency [Hz]
+    T : float  sweep time, also the duration [s]
+    t_f : float  fade-in time [s]
+    """
+
+    A_max: float = 0.05
+    V_max: float = 0.4
+    f0: float = 0.5
+    f1: float = 10.0
+    T: float = 1.0
+    t_f: float = 0.02
+
+    @property
+    def duration(self) -> float:
+        return self.T
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        phase = 2.0 * np.pi * (self.f0 * t + (self.f1 - self.f0) * t**2 / (2.0 * self.T))
+        f = self.f0 + (self.f1 - self.f0) * t / self.T
+        A = np.minimum(self.A_max, self.V_max / (2.0 * np.pi * f))
+        w = np.where(t < self.t_f, 0.5 * (1.0 - np.cos(np.pi * t / max(self.t_f, 1e-300))), 1.0)
+        return w * A * np.sin(phase)
+
+
+@dataclass(frozen=True)
+class Step(_Checked):
+    """Step of `amplitude` [rad] at time `t_0` [s]."""
+
+    amplitude: float = 0.02
+    t_0: float = 0.01
+    duration: float = 0.5
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        return np.where(t >= self.t_0, self.amplitude, 0.0)
+
+
+@dataclass(frozen=True)
+class Ramp(_Checked):
+    """Ramp of `rate` [rad/s] starting at `t_0` [s]."""
+
+    rate: float = 0.1
+    t_0: float = 0.01
+    duration: float = 0.5
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        return self.rate * np.maximum(t - self.t_0, 0.0)
+
+
+@dataclass(frozen=True)
+class Sine(_Checked):
+    """Sine of `amplitude` [rad] and `frequency` [Hz], starting from rest at zero."""
+
+    amplitude: float = 0.02
+    frequency: float = 2.0
+    duration: float = 1.0
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        return self.amplitude * np.sin(2.0 * np.pi * self.frequency * t)
+
+
+COMMANDS: dict[str, type] = {"chirp": Chirp, "step": Step, "ramp": Ramp, "sine": Sine}
+
+
+def make_command(name: str, **settings: Any) -> Command:
+    """Build a command by name (``chirp``, ``step``, ``ramp``, ``sine``) with optional settings."""
+    try:
+        cls = COMMANDS[name]
+    except KeyError:
+        raise InputError(f"unknown command {name!r}; choose one of {', '.join(COMMANDS)}") from None
+    try:
+        return cls(**settings)  # type: ignore[no-any-return]
+    except TypeError as exc:
+        raise InputError(f"bad settings for command {name!r}: {exc}") from None

@@ -1,0 +1,148 @@
+"""The fault vector k = (k1..k8), each in [0, 1] (DESIGN §2), and its mapping to physical parameters.
+
+| k  | name                 | maps to                                   | healthy |
+|----|----------------------|-------------------------------------------|---------|
+| k1 | friction             | F_S = F_S0·(1 + 2·k1), F_D = F_D0·(1 + 2·k1) | 0    |
+| k2 | backlash             | B = B0·(1 + 99·k2)                        | 0       |
+| k3 | short_a              | N_A = 1 − k3 (fraction of healthy turns)  | 0       |
+| k4 | short_b              | N_B = 1 − k4                              | 0       |
+| k5 | short_c              | N_C = 1 − k5                              | 0       |
+| k6 | eccentricity         | ζ = k6                                    | 0       |
+| k7 | eccentricity_phase   | φ_e = 2π·k7                               | any     |
+| k8 | kp_drift             | K_P = K_P0·(0.5 + k8)                     | 0.5     |
+
+Faults are data: the mapping produces per-phase parameters and factors that the kernels read.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+from .params import EmaParams
+
+__all__ = [
+    "FAULT_NAMES",
+    "FAULT_DESCRIPTIONS",
+    "HEALTHY",
+    "N_MIN",
+    "TABLE1_REFERENCE",
+    "FaultedParameters",
+    "apply_faults",
+    "as_fault_vector",
+    "parse_faults",
+]
+
+FAULT_NAMES: tuple[str, ...] = (
+    "friction",
+    "backlash",
+    "short_a",
+    "short_b",
+    "short_c",
+    "eccentricity",
+    "eccentricity_phase",
+    "kp_drift",
+)
+FAULT_DESCRIPTIONS: tuple[str, ...] = (
+    "dry friction, F = F0·(1 + 2·k1)",
+    "backlash, B = B0·(1 + 99·k2)",
+    "coil short circuit phase A, N_A = 1 − k3",
+    "coil short circuit phase B, N_B = 1 − k4",
+    "coil short circuit phase C, N_C = 1 − k5",
+    "static eccentricity modulus, ζ = k6",
+    "static eccentricity phase, φ_e = 2π·k7",
+    "proportional-gain drift, K_P = K_P0·(0.5 + k8)",
+)
+HEALTHY: NDArray[np.float64] = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5])
+HEALTHY.setflags(write=False)
+TABLE1_REFERENCE: NDArray[np.float64] = np.array(
+    [0.2383, 0.5003, 5.32e-7, 0.4503, 0.0404, 0.0028, 0.2785, 0.5]
+)  # the paper's Table 1 "Ref." row
+TABLE1_REFERENCE.setflags(write=False)
+
+N_MIN = 0.05
+"""Smallest fraction of healthy turns kept in a shorted coil (DESIGN §3.6): N_x = max(1 − k, N_MIN)."""
+
+
+def as_fault_vector(k: ArrayLike, *, name: str = "fault vector") -> NDArray[np.float64]:
+    """Validate and return k as a new float array of 8 values in [0, 1].
+
+    Raises `InputError` with a one-line reason for a wrong length, a non-number, NaN/inf or a value
+    outside [0, 1].
+    """
+    try:
+        arr = np.array(k, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be 8 numbers, got {k!r}") from None
+    if arr.ndim != 1 or arr.size != len(FAULT_NAMES):
+        raise InputError(f"{name} must have {len(FAULT_NAMES)} values (k1..k8), got {arr.size}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"{name}: k{i + 1} ({FAULT_NAMES[i]}) is {arr[i]}, must be a number in [0, 1]")
+    out = (arr < 0.0) | (arr > 1.0)
+    if out.any():
+        i = int(np.argmax(out))
+        raise InputError(f"{name}: k{i + 1} ({FAULT_NAMES[i]}) = {arr[i]:g} is outside [0, 1]")
+    return arr
+
+
+def parse_faults(text: str) -> NDArray[np.float64]:
+    """Parse the CLI form ``K1,...,K8`` into a validated fault vector."""
+    parts = [p.strip() for p in text.split(",")]
+    values: list[float] = []
+    for i, part in enumerate(parts):
+        try:
+            values.append(float(part))
+        except ValueError:
+            raise InputError(f"--faults: value {i + 1} ({part!r}) is not a number") from None
+    return as_fault_vector(values, name="--faults")
+
+
+@dataclass(frozen=True)
+class FaultedParameters:
+    """Physical parameters after applying a fault vector (DESIGN §2).
+
+    F_S : float  static friction, motor side [N·m]
+    F_D : float  dynamic friction, motor side [N·m]
+    B : float  total backlash, user side [rad]
+    N : tuple[float, float, float]  fraction of healthy turns of phases A, B, C [-]
+    zeta : float  relative static eccentricity [-]
+    phi_e : float  eccentricity direction, electrical [rad]
+    K_P : float  proportional gain of the position PID [A/rad]
+    """
+
+    F_S: float
+    F_D: float
+    B: float
+    N: tuple[float, float, float]
+    zeta: float
+    phi_e: float
+    K_P: float
+
+
+def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
+    """Map a fault vector to the physical parameters it changes (DESIGN §2)."""
+    k = as_fault_vector(k)
+    tr = params.transmission
+    friction = 1.0 + 2.0 * k[0]
+    N = tuple(max(1.0 - float(kx), N_MIN) for kx in k[2:5])
+    return FaultedParameters(
+        F_S=tr.F_S0 * friction,
+        F_D=tr.F_D0 * friction,
+        B=tr.B0 * (1.0 + 99.0 * k[1]),
+        N=(N[0], N[1], N[2]),
+        zeta=float(k[5]),
+        phi_e=2.0 * math.pi * float(k[6]),
+        K_P=params.controller.K_P0 * (0.5 + k[7]),
+    )
+
+
+def describe(k: Sequence[float]) -> str:
+    """One line naming each fault and its value, e.g. for logs."""
+    return ", ".join(f"k{i + 1} {n}={v:.4g}" for i, (n, v) in enumerate(zip(FAULT_NAMES, k, strict=True)))

@@ -1,0 +1,151 @@
+"""Reading and writing traces (DESIGN §8): HDF5 (``.h5``/``.hdf5``) or CSV with a JSON side file.
+
+HDF5: one float64 dataset per signal, named as the signal (SI units in each dataset's ``unit``
+attribute); the metadata as root attributes, scalars as they are and nested values
+(parameters, command) as JSON strings.
+
+CSV: one column per signal with a header row of the names; the metadata, with the units, in
+``FILE.json`` beside it (``out.csv`` → ``out.csv.json``).
+
+Writes are atomic: everything goes to temporary files that replace the targets only once complete,
+so a failure leaves nothing half-written.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+from .results import REQUIRED_SIGNALS, UNITS, SimResult
+
+__all__ = ["TRACE_SUFFIXES", "check_trace_path", "read_trace", "write_trace"]
+
+TRACE_SUFFIXES = (".h5", ".hdf5", ".csv")
+
+
+def check_trace_path(path: str | os.PathLike[str], *, for_writing: bool = True) -> Path:
+    """Validate a trace path's extension (and, for writing, that its folder exists)."""
+    p = Path(path)
+    if p.suffix.lower() not in TRACE_SUFFIXES:
+        raise InputError(f"{p}: unsupported file type {p.suffix or '(none)'!r}; use .h5 or .csv")
+    if for_writing and not p.parent.is_dir():
+        raise InputError(f"{p}: folder {p.parent} does not exist")
+    if not for_writing and not p.is_file():
+        raise InputError(f"{p}: no such file")
+    return p
+
+
+@contextmanager
+def _atomic(target: Path) -> Iterator[Path]:
+    """Yield a temporary path beside `target`; it replaces `target` only if the block succeeds."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def write_trace(result: SimResult, path: str | os.PathLike[str]) -> Path:
+    """Write `result` to `path` (format by extension); returns the path written."""
+    p = check_trace_path(path)
+    metadata = _jsonable(dict(result.metadata))
+    if p.suffix.lower() == ".csv":
+        names = result.names
+        data = np.column_stack([result[n] for n in names])
+        side = p.with_name(p.name + ".json")
+        with _atomic(p) as tmp_csv, _atomic(side) as tmp_json:
+            np.savetxt(tmp_csv, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+            units = {n: UNITS.get(n, "") for n in names}
+            tmp_json.write_text(json.dumps({"metadata": metadata, "units": units}, indent=2))
+        return p
+    import h5py
+
+    with _atomic(p) as tmp, h5py.File(tmp, "w") as f:
+        for name in result.names:
+            ds = f.create_dataset(name, data=result[name])
+            ds.attrs["unit"] = UNITS.get(name, "")
+        for key, value in metadata.items():
+            f.attrs[key] = json.dumps(value) if isinstance(value, (dict, list)) else value
+    return p
+
+
+def read_trace(path: str | os.PathLike[str]) -> SimResult:
+    """Read a trace written by `write_trace` (or any file of the same schema).
+
+    Raises `InputError` for a missing or unreadable file, missing required signals
+    (t, theta_cmd, theta_u, i_q), signals of unequal length, NaN/inf values or a time axis that
+    is not strictly increasing.
+    """
+    p = check_trace_path(path, for_writing=False)
+    try:
+        if p.suffix.lower() == ".csv":
+            columns, metadata = _read_csv(p)
+        else:
+            columns, metadata = _read_h5(p)
+    except InputError:
+        raise
+    except Exception as exc:  # corrupt file: say which and why, in one line
+        raise InputError(f"{p}: cannot read trace ({type(exc).__name__}: {exc})".splitlines()[0]) from None
+    missing = [n for n in REQUIRED_SIGNALS if n not in columns]
+    if missing:
+        raise InputError(f"{p}: missing signal(s) {', '.join(missing)}")
+    n = len(columns["t"])
+    for name, values in columns.items():
+        if values.ndim != 1 or len(values) != n:
+            raise InputError(f"{p}: signal {name!r} has {values.size} values, t has {n}")
+        if not np.all(np.isfinite(values)):
+            raise InputError(f"{p}: signal {name!r} contains NaN or inf")
+    if n < 2 or np.any(np.diff(columns["t"]) <= 0):
+        raise InputError(f"{p}: time axis t must hold at least 2 strictly increasing samples")
+    t = columns.pop("t")
+    return SimResult(t=t, signals=columns, metadata=metadata)
+
+
+def _read_csv(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    with p.open() as fh:
+        header = fh.readline().strip().lstrip("#").strip()
+    names = [h.strip() for h in header.split(",")]
+    data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    if data.shape[1] != len(names):
+        raise InputError(f"{p}: header names {len(names)} columns, rows have {data.shape[1]}")
+    side = p.with_name(p.name + ".json")
+    metadata = json.loads(side.read_text()).get("metadata", {}) if side.is_file() else {}
+    return {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}, metadata
+
+
+def _read_h5(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    import h5py
+
+    with h5py.File(p, "r") as f:
+        columns = {name: np.asarray(f[name][()], dtype=np.float64) for name in f if isinstance(f[name], h5py.Dataset)}
+        metadata: dict[str, Any] = {}
+        for key, value in f.attrs.items():
+            if isinstance(value, bytes):
+                value = value.decode()
+            if isinstance(value, str) and value[:1] in "[{":
+                value = json.loads(value)
+            elif isinstance(value, np.generic):
+                value = value.item()
+            metadata[key] = value
+    return columns, metadata

@@ -1,0 +1,10 @@
+"""Numba kernels: the equations, and nothing else.
+
+Pure functions of floats, arrays and `NamedTuple` parameter packs whose field names are the
+paper's symbols. This sub-package imports nothing from the rest of emaphm; the API layer
+(`emaphm.models`) validates input, packs parameters and calls these kernels.
+
+Layout (the block diagram): `controller` (ACE position PID), `pmsm_abc` (hysteresis inverter and
+three-phase stator), `mechanics` (gearbox, friction, backlash, end-stops), `sensors` (ADC),
+`transforms` (Clarke–Park), `hf_twin` (the one fixed-step loop of the high-fidelity twin).
+"""

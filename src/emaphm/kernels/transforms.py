@@ -1,0 +1,47 @@
+"""Amplitude-invariant Clarke and Park transforms (DESIGN §3.9).
+
+    i_alpha = (2/3)·(i_a − i_b/2 − i_c/2),  i_beta = (i_b − i_c)/√3
+    i_d = i_alpha·cos θ_e + i_beta·sin θ_e,  i_q = −i_alpha·sin θ_e + i_beta·cos θ_e
+
+With this convention a balanced set i_x = −I·sin(θ_e − γ_x) (γ = 0, 2π/3, −2π/3) gives
+i_d = 0 and i_q = I: i_q equals the phase-current amplitude. Works on floats and on arrays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._jit import jit
+
+SQRT3 = math.sqrt(3.0)
+
+
+@jit
+def clarke(i_a, i_b, i_c):  # type: ignore[no-untyped-def]
+    """(i_a, i_b, i_c) -> (i_alpha, i_beta), amplitude invariant."""
+    return (2.0 / 3.0) * (i_a - 0.5 * i_b - 0.5 * i_c), (i_b - i_c) / SQRT3
+
+
+@jit
+def inverse_clarke(i_alpha, i_beta):  # type: ignore[no-untyped-def]
+    """(i_alpha, i_beta) -> (i_a, i_b, i_c) with zero homopolar component."""
+    return i_alpha, -0.5 * i_alpha + 0.5 * SQRT3 * i_beta, -0.5 * i_alpha - 0.5 * SQRT3 * i_beta
+
+
+@jit
+def park(i_alpha, i_beta, theta_e):  # type: ignore[no-untyped-def]
+    """(i_alpha, i_beta) at electrical angle theta_e [rad] -> (i_d, i_q)."""
+    s = np.sin(theta_e)
+    c = np.cos(theta_e)
+    return i_alpha * c + i_beta * s, -i_alpha * s + i_beta * c
+
+
+@jit
+def inverse_park(i_d, i_q, theta_e):  # type: ignore[no-untyped-def]
+    """(i_d, i_q) at electrical angle theta_e [rad] -> (i_alpha, i_beta)."""
+    s = np.sin(theta_e)
+    c = np.cos(theta_e)
+    return i_d * c - i_q * s, i_d * s + i_q * c
+

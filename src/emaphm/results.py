@@ -1,0 +1,63 @@
+"""`SimResult`: the sampled signals of one simulation, with their units and metadata."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["REQUIRED_SIGNALS", "SimResult", "UNITS"]
+
+UNITS: dict[str, str] = {
+    "t": "s",
+    "theta_cmd": "rad",
+    "theta_u": "rad",
+    "i_q": "A",
+    "i_a": "A",
+    "i_b": "A",
+    "i_c": "A",
+    "theta_e": "rad",
+    "omega_m": "rad/s",
+    "i_q_ref": "A",
+    "T_m": "N·m",
+    "theta_u_true": "rad",
+}
+REQUIRED_SIGNALS = ("t", "theta_cmd", "theta_u", "i_q")
+
+
+@dataclass(frozen=True)
+class SimResult:
+    """Signals on the sample grid t (SI units, see `UNITS`) and the metadata that produced them.
+
+    Signals are reached as attributes (``result.i_q``) or by name (``result["i_a"]``).
+    Measured signals (``theta_u``, ``i_a``, ``i_b``, ``i_c``, ``i_q``) carry the ADC and, when
+    enabled, the noise; ``theta_u_true`` and ``T_m`` are the simulator's internal truth.
+    """
+
+    t: NDArray[np.float64]
+    signals: Mapping[str, NDArray[np.float64]]
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name, values in self.signals.items():
+            if values.shape != self.t.shape:
+                raise ValueError(f"signal {name!r} has shape {values.shape}, t has {self.t.shape}")
+
+    def __getattr__(self, name: str) -> NDArray[np.float64]:
+        signals = self.__dict__.get("signals", {})
+        if name in signals:
+            return signals[name]  # type: ignore[no-any-return]
+        raise AttributeError(f"SimResult has no signal or attribute {name!r}")
+
+    def __getitem__(self, name: str) -> NDArray[np.float64]:
+        if name == "t":
+            return self.t
+        return self.signals[name]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """All signal names, time first."""
+        return ("t", *self.signals)
