@@ -53,13 +53,19 @@ def _root(
 
 @app.command()
 def simulate(
-    output: Annotated[Path, typer.Option("--output", "-o", help="Trace to write: .h5 or .csv (+ .csv.json).")],
-    faults: Annotated[str, typer.Option(help="Fault vector k1..k8, comma separated, each in [0, 1].")] = HEALTHY_TEXT,
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Trace to write: .h5 or .csv (+ .csv.json).")
+    ],
+    faults: Annotated[
+        str, typer.Option(help="Fault vector k1..k8, comma separated, each in [0, 1].")
+    ] = HEALTHY_TEXT,
     model: Annotated[str, typer.Option(help="Model fidelity: hf.")] = "hf",
     noise: Annotated[bool, typer.Option("--noise/--no-noise", help="Seeded measurement noise.")] = True,
     seed: Annotated[int, typer.Option(help="Seed of every random choice.")] = 0,
     command: Annotated[str, typer.Option(help=f"Position command: {', '.join(COMMANDS)}.")] = "chirp",
-    duration: Annotated[float | None, typer.Option(help="Simulated time [s]; default: the command's.")] = None,
+    duration: Annotated[
+        float | None, typer.Option(help="Simulated time [s]; default: the command's.")
+    ] = None,
 ) -> None:
     """Simulate the actuator with a fault vector and write the sampled signals."""
     from .io import check_trace_path, write_trace

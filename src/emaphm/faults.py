@@ -27,8 +27,8 @@ from .errors import InputError
 from .params import EmaParams
 
 __all__ = [
-    "FAULT_NAMES",
     "FAULT_DESCRIPTIONS",
+    "FAULT_NAMES",
     "HEALTHY",
     "N_MIN",
     "TABLE1_REFERENCE",

@@ -138,7 +138,9 @@ def _read_h5(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     import h5py
 
     with h5py.File(p, "r") as f:
-        columns = {name: np.asarray(f[name][()], dtype=np.float64) for name in f if isinstance(f[name], h5py.Dataset)}
+        columns = {
+            name: np.asarray(f[name][()], dtype=np.float64) for name in f if isinstance(f[name], h5py.Dataset)
+        }
         metadata: dict[str, Any] = {}
         for key, value in f.attrs.items():
             if isinstance(value, bytes):

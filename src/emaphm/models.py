@@ -19,7 +19,7 @@ from .faults import HEALTHY, FaultedParameters, apply_faults, as_fault_vector
 from .kernels.controller import ControllerPack
 from .kernels.hf_twin import N_OUT, OUT_COLUMNS, simulate_hf
 from .kernels.mechanics import MechanicsPack
-from .kernels.pmsm_abc import StatorPack
+from .kernels.pmsm_abc import StatorPack, stator_pack
 from .kernels.sensors import adc
 from .kernels.transforms import clarke, park
 from .params import EmaParams
@@ -66,12 +66,11 @@ class HighFidelityEma:
     def stator_pack(self, fp: FaultedParameters) -> StatorPack:
         """Per-phase stator parameters with shorts (turn removal) and eccentricity applied."""
         m, inv = self.params.motor, self.params.inverter
-        N_a, N_b, N_c = fp.N
-        return StatorPack(
-            inv.V_dc, inv.h, float(m.p),
-            N_a * m.R_s, N_b * m.R_s, N_c * m.R_s,  # DESIGN §3.6: R_x = N_x·R_s
-            N_a**2 * m.L_s, N_b**2 * m.L_s, N_c**2 * m.L_s,  # L_x = N_x²·L_s
-            N_a * m.k_e, N_b * m.k_e, N_c * m.k_e,  # k_e,x = N_x·k_e
+        return stator_pack(
+            inv.V_dc, inv.h, m.p,
+            [n * m.R_s for n in fp.N],  # DESIGN §3.6: R_x = N_x·R_s
+            [n**2 * m.L_s for n in fp.N],  # L_x = N_x²·L_s
+            [n * m.k_e for n in fp.N],  # k_e,x = N_x·k_e
             fp.zeta, fp.phi_e,
         )  # fmt: skip
 
@@ -104,7 +103,7 @@ class HighFidelityEma:
         if not (math.isfinite(duration) and duration > 0):
             raise InputError(f"duration must be > 0 s, got {duration!r}")
         f_s = params.controller.f_s
-        n = int(round(duration * f_s)) + 1
+        n = round(duration * f_s) + 1
         t = np.arange(n) / f_s
         theta_cmd = np.ascontiguousarray(self.command(t), dtype=np.float64)
 
@@ -192,4 +191,3 @@ def simulate(
     if model not in models:
         raise InputError(f"unknown model {model!r}; available: {', '.join(models)}")
     return models[model](params, command).simulate(faults, noise=noise, seed=seed, duration=duration)
-

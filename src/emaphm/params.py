@@ -242,7 +242,7 @@ class EmaParams(_Validated):
     @property
     def steps_per_sample(self) -> int:
         """Integration steps per controller/sensor sample period."""
-        return int(round(1.0 / (self.controller.f_s * self.integration.dt)))
+        return round(1.0 / (self.controller.f_s * self.integration.dt))
 
     def to_dict(self) -> dict[str, dict[str, float]]:
         """Plain nested dict of every value (for result metadata)."""
@@ -272,5 +272,7 @@ def parameter_table_markdown() -> str:
         for f in dataclasses.fields(group):
             m = f.metadata
             value = getattr(instance, f.name)
-            lines.append(f"| {group.__name__} | `{f.name}` ({m['symbol']}) | {m['doc']} | {value:g} | {m['unit']} |")
+            lines.append(
+                f"| {group.__name__} | `{f.name}` ({m['symbol']}) | {m['doc']} | {value:g} | {m['unit']} |"
+            )
     return "\n".join(lines) + "\n"

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["REQUIRED_SIGNALS", "SimResult", "UNITS"]
+__all__ = ["REQUIRED_SIGNALS", "UNITS", "SimResult"]
 
 UNITS: dict[str, str] = {
     "t": "s",

@@ -30,7 +30,9 @@ class ControllerPack(NamedTuple):
 
 
 @jit
-def pid_step(theta_cmd: float, theta_meas: float, omega_m: float, integral: float, omega_f: float, cp: ControllerPack):  # type: ignore[no-untyped-def]
+def pid_step(
+    theta_cmd: float, theta_meas: float, omega_m: float, integral: float, omega_f: float, cp: ControllerPack
+):  # type: ignore[no-untyped-def]
     """One controller sample: returns (i_q,ref [A], new ∫e [rad·s], new filtered speed ω̃_m [rad/s])."""
     # first-order speed filter, exact (zero-order-hold) discretisation
     omega_f += (1.0 - math.exp(-cp.T_s / cp.tau_D)) * (omega_m - omega_f)

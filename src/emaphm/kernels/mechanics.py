@@ -32,7 +32,9 @@ class MechanicsPack(NamedTuple):
 
 
 @jit
-def friction_step(omega_m: float, T_act: float, dt: float, J: float, C: float, F_S: float, F_D: float) -> float:
+def friction_step(
+    omega_m: float, T_act: float, dt: float, J: float, C: float, F_S: float, F_D: float
+) -> float:
     """Speed after one step of Borello's dry-friction model [rad/s].
 
     T_act is the active (driving) torque on the shaft. Four cases, decided every step:

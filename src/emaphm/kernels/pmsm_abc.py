@@ -32,7 +32,11 @@ HALF_SQRT3 = 0.5 * math.sqrt(3.0)
 
 
 class StatorPack(NamedTuple):
-    """Inverter and per-phase stator parameters with faults applied."""
+    """Inverter and per-phase stator parameters with faults applied; build it with `stator_pack`.
+
+    The reciprocal inductances and the eccentricity components are stored so that the hot loop
+    multiplies instead of dividing and calls no trigonometry for φ_e.
+    """
 
     V_dc: float  # DC bus [V]
     h: float  # hysteresis band, total [A]
@@ -48,6 +52,22 @@ class StatorPack(NamedTuple):
     k_e_c: float
     zeta: float  # relative static eccentricity [-]
     phi_e: float  # eccentricity direction [rad]
+    inv_L_a: float  # 1/L_x [1/H]
+    inv_L_b: float
+    inv_L_c: float
+    L_n: float  # 1/Σ_x(1/L_x), the neutral's parallel inductance [H]
+    zeta_cos: float  # ζ·cos φ_e [-]
+    zeta_sin: float  # ζ·sin φ_e [-]
+
+
+def stator_pack(V_dc, h, p, R, L, k_e, zeta, phi_e):  # type: ignore[no-untyped-def]
+    """StatorPack from per-phase triples R, L, k_e, with the derived fields filled in."""
+    inv_L = [1.0 / x for x in L]
+    return StatorPack(
+        float(V_dc), float(h), float(p), *map(float, R), *map(float, L), *map(float, k_e),
+        float(zeta), float(phi_e), *inv_L, 1.0 / sum(inv_L),
+        zeta * math.cos(phi_e), zeta * math.sin(phi_e),
+    )  # fmt: skip
 
 
 @jit
@@ -73,8 +93,8 @@ def stator_derivatives(i_a, i_b, i_c, v_a0, v_b0, v_c0, e_a, e_b, e_c, sp):  # t
     w_b = v_b0 - sp.R_b * i_b - e_b
     w_c = v_c0 - sp.R_c * i_c - e_c
     # DESIGN §3.4: v_n0 = Σ w_x/L_x ⁄ Σ 1/L_x
-    v_n0 = (w_a / sp.L_a + w_b / sp.L_b + w_c / sp.L_c) / (1.0 / sp.L_a + 1.0 / sp.L_b + 1.0 / sp.L_c)
-    return (w_a - v_n0) / sp.L_a, (w_b - v_n0) / sp.L_b, (w_c - v_n0) / sp.L_c
+    v_n0 = (w_a * sp.inv_L_a + w_b * sp.inv_L_b + w_c * sp.inv_L_c) * sp.L_n
+    return (w_a - v_n0) * sp.inv_L_a, (w_b - v_n0) * sp.inv_L_b, (w_c - v_n0) * sp.inv_L_c
 
 
 @jit
@@ -89,7 +109,7 @@ def stator_step(i_a, i_b, i_c, s_a, s_b, s_c, theta_e, omega_m, i_q_ref, dt, n_s
     cos_e = math.cos(theta_e)
     u_a, u_b, u_c = phase_directions(sin_e, cos_e)
     # DESIGN §3.7: eccentricity modulates the coupling of every phase, cos(θ_e + φ_e) expanded
-    ecc = 1.0 - sp.zeta * (cos_e * math.cos(sp.phi_e) - sin_e * math.sin(sp.phi_e))
+    ecc = 1.0 - (cos_e * sp.zeta_cos - sin_e * sp.zeta_sin)
     g_a = sp.k_e_a * ecc * u_a  # k_e,x(θ)·u_x: back-EMF per rad/s and torque per ampere
     g_b = sp.k_e_b * ecc * u_b
     g_c = sp.k_e_c * ecc * u_c
@@ -106,7 +126,9 @@ def stator_step(i_a, i_b, i_c, s_a, s_b, s_c, theta_e, omega_m, i_q_ref, dt, n_s
         s_a = hysteresis(i_a, r_a, s_a, sp.h)
         s_b = hysteresis(i_b, r_b, s_b, sp.h)
         s_c = hysteresis(i_c, r_c, s_c, sp.h)
-        d_a, d_b, d_c = stator_derivatives(i_a, i_b, i_c, s_a * half_V, s_b * half_V, s_c * half_V, e_a, e_b, e_c, sp)
+        d_a, d_b, d_c = stator_derivatives(
+            i_a, i_b, i_c, s_a * half_V, s_b * half_V, s_c * half_V, e_a, e_b, e_c, sp
+        )
         i_a += h_sub * d_a
         i_b += h_sub * d_b
         i_c += h_sub * d_c

@@ -44,4 +44,3 @@ def inverse_park(i_d, i_q, theta_e):  # type: ignore[no-untyped-def]
     s = np.sin(theta_e)
     c = np.cos(theta_e)
     return i_d * c - i_q * s, i_d * s + i_q * c
-

@@ -1,0 +1,57 @@
+"""HF twin speed: wall seconds per simulated second on one thread (DESIGN §9).
+
+Target ≤ 0.15 s, goal ≤ 0.05 s. Run:
+
+    python benchmarks/bench_hf.py [--repeats 5]
+
+The first call loads (or compiles) the numba kernels and is reported apart; the figure is the
+median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one thread, as the target states
+
+import numpy as np  # noqa: E402
+
+import emaphm  # noqa: E402
+
+CASES = {
+    "healthy": emaphm.HEALTHY,
+    "Table 1 reference": emaphm.TABLE1_REFERENCE,
+    "shorts k3=k4=0.5": np.array([0, 0, 0.5, 0.5, 0, 0, 0, 0.5]),
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+
+    t0 = time.perf_counter()
+    emaphm.simulate(emaphm.HEALTHY, duration=0.01)
+    first = time.perf_counter() - t0
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {platform.machine()}, "
+          f"{os.cpu_count()} cores, NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}")
+    print(f"first call (import of kernels: compile or cache load): {first:.2f} s")
+    print(f"{'case':<22} {'sub-steps':>9} {'sim s':>6} {'wall s/sim s (median)':>22} {'min':>7} {'max':>7}")
+    for name, k in CASES.items():
+        walls = []
+        for seed in range(args.repeats):
+            t0 = time.perf_counter()
+            r = emaphm.simulate(k, seed=seed)
+            walls.append(time.perf_counter() - t0)
+        sim_s = float(r.t[-1])
+        per = [w / sim_s for w in walls]
+        print(f"{name:<22} {r.metadata['electrical_substeps']:>9} {sim_s:>6.2f} "
+              f"{statistics.median(per):>22.4f} {min(per):>7.4f} {max(per):>7.4f}")
+
+
+if __name__ == "__main__":
+    main()
