@@ -18,9 +18,9 @@ import time
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one thread, as the target states
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-import emaphm  # noqa: E402
+import emaphm
 
 CASES = {
     "healthy": emaphm.HEALTHY,
@@ -37,8 +37,10 @@ def main() -> None:
     t0 = time.perf_counter()
     emaphm.simulate(emaphm.HEALTHY, duration=0.01)
     first = time.perf_counter() - t0
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {platform.machine()}, "
-          f"{os.cpu_count()} cores, NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}")
+    print(
+        f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {platform.machine()}, "
+        f"{os.cpu_count()} cores, NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}"
+    )
     print(f"first call (import of kernels: compile or cache load): {first:.2f} s")
     print(f"{'case':<22} {'sub-steps':>9} {'sim s':>6} {'wall s/sim s (median)':>22} {'min':>7} {'max':>7}")
     for name, k in CASES.items():
@@ -49,8 +51,10 @@ def main() -> None:
             walls.append(time.perf_counter() - t0)
         sim_s = float(r.t[-1])
         per = [w / sim_s for w in walls]
-        print(f"{name:<22} {r.metadata['electrical_substeps']:>9} {sim_s:>6.2f} "
-              f"{statistics.median(per):>22.4f} {min(per):>7.4f} {max(per):>7.4f}")
+        print(
+            f"{name:<22} {r.metadata['electrical_substeps']:>9} {sim_s:>6.2f} "
+            f"{statistics.median(per):>22.4f} {min(per):>7.4f} {max(per):>7.4f}"
+        )
 
 
 if __name__ == "__main__":
