@@ -143,6 +143,6 @@ def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
     )
 
 
-def describe(k: Sequence[float]) -> str:
+def describe(k: Sequence[float] | NDArray[np.float64]) -> str:
     """One line naming each fault and its value, e.g. for logs."""
     return ", ".join(f"k{i + 1} {n}={v:.4g}" for i, (n, v) in enumerate(zip(FAULT_NAMES, k, strict=True)))

@@ -251,12 +251,12 @@ class EmaParams(_Validated):
     @classmethod
     def from_dict(cls, data: dict[str, dict[str, float]]) -> EmaParams:
         """Inverse of `to_dict`; unknown groups or fields raise `InputError`."""
-        groups = {f.name: f.default_factory for f in dataclasses.fields(cls)}  # type: ignore[misc]
+        groups: dict[str, Any] = {f.name: f.default_factory for f in dataclasses.fields(cls)}
         unknown = set(data) - set(groups)
         if unknown:
             raise InputError(f"unknown parameter group(s): {', '.join(sorted(unknown))}")
         try:
-            return cls(**{name: groups[name](**values) for name, values in data.items()})  # type: ignore[misc]
+            return cls(**{name: groups[name](**values) for name, values in data.items()})
         except TypeError as exc:
             raise InputError(f"bad parameter set: {exc}") from None
 

@@ -26,9 +26,7 @@ import math
 from typing import NamedTuple
 
 from ._jit import jit
-from .transforms import clarke
-
-HALF_SQRT3 = 0.5 * math.sqrt(3.0)
+from .transforms import clarke, phase_directions
 
 
 class StatorPack(NamedTuple):
@@ -68,12 +66,6 @@ def stator_pack(V_dc, h, p, R, L, k_e, zeta, phi_e):  # type: ignore[no-untyped-
         float(zeta), float(phi_e), *inv_L, 1.0 / sum(inv_L),
         zeta * math.cos(phi_e), zeta * math.sin(phi_e),
     )  # fmt: skip
-
-
-@jit
-def phase_directions(sin_e: float, cos_e: float):  # type: ignore[no-untyped-def]
-    """u_x = −sin(θ_e − γ_x) for x = a, b, c from sin θ_e and cos θ_e (no further trigonometry)."""
-    return -sin_e, 0.5 * sin_e + HALF_SQRT3 * cos_e, 0.5 * sin_e - HALF_SQRT3 * cos_e
 
 
 @jit

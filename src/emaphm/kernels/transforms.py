@@ -16,6 +16,7 @@ import numpy as np
 from ._jit import jit
 
 SQRT3 = math.sqrt(3.0)
+HALF_SQRT3 = 0.5 * SQRT3
 
 
 @jit
@@ -44,3 +45,13 @@ def inverse_park(i_d, i_q, theta_e):  # type: ignore[no-untyped-def]
     s = np.sin(theta_e)
     c = np.cos(theta_e)
     return i_d * c - i_q * s, i_d * s + i_q * c
+
+
+@jit
+def phase_directions(sin_e, cos_e):  # type: ignore[no-untyped-def]
+    """u_x = −sin(θ_e − γ_x) for x = a, b, c (γ = 0, 2π/3, −2π/3) from sin θ_e and cos θ_e.
+
+    The i_d = 0 current reference of phase x is i_q·u_x, and u_x² are the sin² terms of the
+    paper's eq. (1): u_a² = sin²(θ_e + π), u_b² = sin²(θ_e + π/3), u_c² = sin²(θ_e − π/3).
+    """
+    return -sin_e, 0.5 * sin_e + HALF_SQRT3 * cos_e, 0.5 * sin_e - HALF_SQRT3 * cos_e
