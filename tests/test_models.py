@@ -55,8 +55,9 @@ def test_currents_stay_regulated_for_extreme_faults(k):
     r = emaphm.simulate(k, noise=False, params=IDEAL, duration=0.05)
     assert r.metadata["electrical_substeps"] > 1
     assert np.all(np.isfinite(r.i_q))
-    # i_q averaged over a period vs the demand held over that period: inside the band h = 0.2 A
-    assert np.max(np.abs(r.i_q[2:] - r.i_q_ref[1:-1])) < 0.2
+    # i_q averaged over a period vs the demand held over that period: within the band h
+    # (healthy and at the N = 0.05 clamp alike, 0.057 to 0.069 A against h = 0.1 A)
+    assert np.max(np.abs(r.i_q[2:] - r.i_q_ref[1:-1])) < emaphm.EmaParams().inverter.h
     assert np.max(np.abs(r.i_a + r.i_b + r.i_c)) < 1e-8
 
 

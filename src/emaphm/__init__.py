@@ -2,8 +2,10 @@
 
 The public API:
 
-- `simulate` runs the high-fidelity twin (DESIGN §3) for a fault vector and returns a `SimResult`;
-- `HighFidelityEma` is the twin itself; `EmaParams` and its groups hold the parameters;
+- `simulate` runs the high-fidelity twin (DESIGN §3) or the monitor model for a fault vector and
+  returns a `SimResult`;
+- `HighFidelityEma` is the twin itself, `MonitorEma` the calibrated low-fidelity monitor model
+  (DESIGN §4); `EmaParams` and its groups hold the parameters;
 - `FAULT_NAMES`, `HEALTHY`, `TABLE1_REFERENCE`, `as_fault_vector`, `apply_faults` define the
   fault vector k1..k8 (DESIGN §2);
 - `Chirp`, `Step`, `Ramp`, `Sine` are position commands;
@@ -16,6 +18,7 @@ from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
 from .io import read_trace, write_trace
 from .models import HighFidelityEma, simulate
+from .monitor import MonitorEma
 from .params import (
     ControllerParams,
     EmaParams,
@@ -38,6 +41,7 @@ __all__ = [
     "InputError",
     "IntegrationParams",
     "InverterParams",
+    "MonitorEma",
     "MotorParams",
     "Ramp",
     "SensorParams",

@@ -6,7 +6,8 @@ Exit status: 0 success, 2 bad input or usage (one-line reason on stderr), 1 fail
 from __future__ import annotations
 
 import sys
-from contextlib import nullcontext
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -59,7 +60,9 @@ def simulate(
     faults: Annotated[
         str, typer.Option(help="Fault vector k1..k8, comma separated, each in [0, 1].")
     ] = HEALTHY_TEXT,
-    model: Annotated[str, typer.Option(help="Model fidelity: hf.")] = "hf",
+    model: Annotated[
+        str, typer.Option(help="hf: the high-fidelity twin; lf: the calibrated monitor model.")
+    ] = "hf",
     noise: Annotated[bool, typer.Option("--noise/--no-noise", help="Seeded measurement noise.")] = True,
     seed: Annotated[int, typer.Option(help="Seed of every random choice.")] = 0,
     command: Annotated[str, typer.Option(help=f"Position command: {', '.join(COMMANDS)}.")] = "chirp",
@@ -78,6 +81,63 @@ def simulate(
         result = run(k, model=model, noise=noise, seed=seed, command=cmd, duration=duration)
     write_trace(result, output)
     err.print(f"wrote {output} ({len(result.t)} samples, model {model}, seed {seed})")
+
+
+@app.command()
+def calibrate(
+    output: Annotated[Path, typer.Option("--output", "-o", help="Calibration file to write (JSON).")] = Path(
+        "lf-calibration.json"
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the GA and of the noisy check.")] = 1,
+    pop_size: Annotated[int, typer.Option(help="GA population size.")] = 40,
+    generations: Annotated[int, typer.Option(help="GA generations.")] = 60,
+    workers: Annotated[int, typer.Option(help="Threads for the population kernel (0: all cores).")] = 0,
+) -> None:
+    """Re-run the LF calibration against the HF twin and write the calibration file."""
+    from .identification.calibrate import calibrate as run_calibration
+
+    if output.suffix.lower() != ".json":
+        raise InputError(f"{output}: the calibration file must end in .json")
+    if not output.parent.is_dir():
+        raise InputError(f"{output}: folder {output.parent} does not exist")
+    _set_workers(workers)
+    with _progress() as update:
+        cal = run_calibration(seed=seed, pop_size=pop_size, generations=generations, progress=update)
+    cal.save(output)
+    for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
+        values = [s["nrmse"] for s in cal.record[key]]
+        err.print(
+            f"{title}: NRMSE {100 * min(values):.1f} to {100 * max(values):.1f} % over {len(values)} scenarios"
+        )
+    err.print(f"wrote {output} (seed {seed}, {cal.record['settings']['wall_time_s']:.0f} s)")
+
+
+def _set_workers(workers: int) -> None:
+    """Threads for numba's parallel kernels: 0 means all cores."""
+    import numba
+
+    if workers < 0 or workers > numba.config.NUMBA_NUM_THREADS:
+        raise InputError(f"--workers must be 0..{numba.config.NUMBA_NUM_THREADS}, got {workers}")
+    numba.set_num_threads(workers or numba.config.NUMBA_NUM_THREADS)
+
+
+@contextmanager
+def _progress() -> Iterator[Callable[[str, int, int], None]]:
+    """A progress bar on an interactive terminal (one task per stage); a no-op otherwise."""
+    if not err.is_terminal:
+        yield lambda stage, done, total: None
+        return
+    from rich.progress import Progress
+
+    with Progress(console=err, transient=True) as bar:
+        tasks: dict[str, Any] = {}
+
+        def update(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(stage, total=total)
+            bar.update(tasks[stage], completed=done)
+
+        yield update
 
 
 @app.command()

@@ -34,7 +34,9 @@ __all__ = [
     "TABLE1_REFERENCE",
     "FaultedParameters",
     "apply_faults",
+    "as_fault_matrix",
     "as_fault_vector",
+    "fault_parameter_columns",
     "parse_faults",
 ]
 
@@ -126,21 +128,44 @@ class FaultedParameters:
     K_P: float
 
 
+def as_fault_matrix(K: ArrayLike, *, name: str = "fault matrix") -> NDArray[np.float64]:
+    """Validate a matrix of fault vectors, one per row (shape (m, 8)), each entry in [0, 1]."""
+    arr = np.array(K, dtype=np.float64, ndmin=2)
+    if arr.ndim != 2 or arr.shape[1] != len(FAULT_NAMES):
+        raise InputError(f"{name} must have shape (m, {len(FAULT_NAMES)}), got {arr.shape}")
+    if not np.all(np.isfinite(arr)) or np.any((arr < 0.0) | (arr > 1.0)):
+        row = int(np.argmax(~np.isfinite(arr).all(axis=1) | ((arr < 0) | (arr > 1)).any(axis=1)))
+        as_fault_vector(arr[row], name=f"{name} row {row}")  # raises with the reason
+    return arr
+
+
+def fault_parameter_columns(K: NDArray[np.float64], params: EmaParams) -> dict[str, NDArray[np.float64]]:
+    """The DESIGN §2 mapping for validated fault rows K (shape (m, 8)): one array per parameter."""
+    tr = params.transmission
+    friction = 1.0 + 2.0 * K[:, 0]
+    N = np.maximum(1.0 - K[:, 2:5], N_MIN)
+    return {
+        "F_S": tr.F_S0 * friction,
+        "F_D": tr.F_D0 * friction,
+        "B": tr.B0 * (1.0 + 99.0 * K[:, 1]),
+        "N_A": N[:, 0],
+        "N_B": N[:, 1],
+        "N_C": N[:, 2],
+        "zeta": K[:, 5].copy(),
+        "phi_e": 2.0 * math.pi * K[:, 6],
+        "K_P": params.controller.K_P0 * (0.5 + K[:, 7]),
+    }
+
+
 def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
     """Map a fault vector to the physical parameters it changes (DESIGN §2)."""
-    k = as_fault_vector(k)
-    tr = params.transmission
-    friction = 1.0 + 2.0 * k[0]
-    N = tuple(max(1.0 - float(kx), N_MIN) for kx in k[2:5])
+    col = {
+        name: float(v[0]) for name, v in fault_parameter_columns(as_fault_vector(k)[None, :], params).items()
+    }
     return FaultedParameters(
-        F_S=tr.F_S0 * friction,
-        F_D=tr.F_D0 * friction,
-        B=tr.B0 * (1.0 + 99.0 * k[1]),
-        N=(N[0], N[1], N[2]),
-        zeta=float(k[5]),
-        phi_e=2.0 * math.pi * float(k[6]),
-        K_P=params.controller.K_P0 * (0.5 + k[7]),
-    )
+        F_S=col["F_S"], F_D=col["F_D"], B=col["B"], N=(col["N_A"], col["N_B"], col["N_C"]),
+        zeta=col["zeta"], phi_e=col["phi_e"], K_P=col["K_P"],
+    )  # fmt: skip
 
 
 def describe(k: Sequence[float] | NDArray[np.float64]) -> str:

@@ -26,7 +26,7 @@ import numpy as np
 from .errors import InputError
 from .results import REQUIRED_SIGNALS, UNITS, SimResult
 
-__all__ = ["TRACE_SUFFIXES", "check_trace_path", "read_trace", "write_trace"]
+__all__ = ["TRACE_SUFFIXES", "atomic_path", "check_trace_path", "read_trace", "write_trace"]
 
 TRACE_SUFFIXES = (".h5", ".hdf5", ".csv")
 
@@ -44,7 +44,7 @@ def check_trace_path(path: str | os.PathLike[str], *, for_writing: bool = True) 
 
 
 @contextmanager
-def _atomic(target: Path) -> Iterator[Path]:
+def atomic_path(target: Path) -> Iterator[Path]:
     """Yield a temporary path beside `target`; it replaces `target` only if the block succeeds."""
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     os.close(fd)
@@ -74,14 +74,14 @@ def write_trace(result: SimResult, path: str | os.PathLike[str]) -> Path:
         names = result.names
         data = np.column_stack([result[n] for n in names])
         side = p.with_name(p.name + ".json")
-        with _atomic(p) as tmp_csv, _atomic(side) as tmp_json:
+        with atomic_path(p) as tmp_csv, atomic_path(side) as tmp_json:
             np.savetxt(tmp_csv, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
             units = {n: UNITS.get(n, "") for n in names}
             tmp_json.write_text(json.dumps({"metadata": metadata, "units": units}, indent=2))
         return p
     import h5py
 
-    with _atomic(p) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_path(p) as tmp, h5py.File(tmp, "w") as f:
         for name in result.names:
             ds = f.create_dataset(name, data=result[name])
             ds.attrs["unit"] = UNITS.get(name, "")

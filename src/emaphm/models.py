@@ -10,7 +10,7 @@ import math
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ._version import __version__
 from .commands import Chirp, Command
@@ -28,7 +28,7 @@ from .results import SimResult
 __all__ = ["HighFidelityEma", "simulate"]
 
 
-def _check_seed(seed: Any) -> int:
+def check_seed(seed: Any) -> int:
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed must be a whole number >= 0, got {seed!r}")
     return int(seed)
@@ -46,7 +46,42 @@ def mechanics_pack(params: EmaParams, fp: FaultedParameters) -> MechanicsPack:
     return MechanicsPack(tr.J, tr.C, fp.F_S, fp.F_D, fp.B, tr.tau, tr.eta, tr.theta_max, tr.T_load)
 
 
-class HighFidelityEma:
+class _EmaModel:
+    """What both fidelities share: parameters, command, the sample grid and the result metadata."""
+
+    model = ""
+
+    def __init__(self, params: EmaParams | None = None, command: Command | None = None) -> None:
+        self.params = params if params is not None else EmaParams()
+        self.command = command if command is not None else Chirp()
+
+    def sample_grid(self, duration: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Sample instants t_k = k/f_s [s] over `duration` (default: the command's) and θ_cmd(t_k) [rad]."""
+        duration = float(self.command.duration if duration is None else duration)
+        if not (math.isfinite(duration) and duration > 0):
+            raise InputError(f"duration must be > 0 s, got {duration!r}")
+        f_s = self.params.controller.f_s
+        t = np.arange(round(duration * f_s) + 1) / f_s
+        return t, np.ascontiguousarray(self.command(t), dtype=np.float64)
+
+    def metadata(
+        self, k: NDArray[np.float64], seed: int, noise: bool, t: NDArray[np.float64], **extra: Any
+    ) -> dict[str, Any]:
+        """What produced a result: model, faults, seed, noise, command, parameters, version."""
+        return {
+            "model": self.model,
+            "faults": k.tolist(),
+            "seed": seed,
+            "noise": bool(noise),
+            "duration": float(t[-1]),
+            "command": {"type": type(self.command).__name__.lower(), **vars(self.command)},
+            "params": self.params.to_dict(),
+            **extra,
+            "version": __version__,
+        }
+
+
+class HighFidelityEma(_EmaModel):
     """The high-fidelity three-phase EMA twin (DESIGN §3).
 
     Parameters
@@ -58,10 +93,6 @@ class HighFidelityEma:
     """
 
     model = "hf"
-
-    def __init__(self, params: EmaParams | None = None, command: Command | None = None) -> None:
-        self.params = params if params is not None else EmaParams()
-        self.command = command if command is not None else Chirp()
 
     def stator_pack(self, fp: FaultedParameters) -> StatorPack:
         """Per-phase stator parameters with shorts (turn removal) and eccentricity applied."""
@@ -97,15 +128,10 @@ class HighFidelityEma:
         deterministic ADC quantisation. `duration` defaults to the command's.
         """
         k = as_fault_vector(faults)
-        seed = _check_seed(seed)
+        seed = check_seed(seed)
         params = self.params
-        duration = float(self.command.duration if duration is None else duration)
-        if not (math.isfinite(duration) and duration > 0):
-            raise InputError(f"duration must be > 0 s, got {duration!r}")
-        f_s = params.controller.f_s
-        n = round(duration * f_s) + 1
-        t = np.arange(n) / f_s
-        theta_cmd = np.ascontiguousarray(self.command(t), dtype=np.float64)
+        t, theta_cmd = self.sample_grid(duration)
+        n = len(t)
 
         sens = params.sensors
         rng = np.random.default_rng(seed)
@@ -148,18 +174,9 @@ class HighFidelityEma:
             "T_m": col["T_m"],
             "theta_u_true": col["theta_u"],
         }
-        metadata = {
-            "model": self.model,
-            "faults": k.tolist(),
-            "seed": seed,
-            "noise": bool(noise),
-            "duration": duration,
-            "command": {"type": type(self.command).__name__.lower(), **vars(self.command)},
-            "params": params.to_dict(),
-            "electrical_substeps": n_sub,
-            "version": __version__,
-        }
-        return SimResult(t=t, signals=signals, metadata=metadata)
+        return SimResult(
+            t=t, signals=signals, metadata=self.metadata(k, seed, noise, t, electrical_substeps=n_sub)
+        )
 
 
 def simulate(
@@ -178,16 +195,19 @@ def simulate(
     ----------
     faults : array_like of 8 floats in [0, 1]
         k1..k8 (see `emaphm.faults`); healthy by default.
-    model : {"hf"}
-        Fidelity. The low-fidelity monitor model arrives with the calibration.
+    model : {"hf", "lf"}
+        Fidelity: the high-fidelity twin or the calibrated low-fidelity monitor model (i_q is
+        then the equivalent current).
     noise : bool
-        Add the seeded measurement noise (ADC quantisation is always on).
+        Add the seeded measurement noise (ADC quantisation is always on in the HF twin).
     seed : int
         Seed of every random choice.
     params, command, duration
         Override the nominal parameters, the FDI chirp, or its duration [s].
     """
-    models: dict[str, type[HighFidelityEma]] = {"hf": HighFidelityEma}
+    from .monitor import MonitorEma
+
+    models: dict[str, type[HighFidelityEma] | type[MonitorEma]] = {"hf": HighFidelityEma, "lf": MonitorEma}
     if model not in models:
         raise InputError(f"unknown model {model!r}; available: {', '.join(models)}")
     return models[model](params, command).simulate(faults, noise=noise, seed=seed, duration=duration)

@@ -102,7 +102,7 @@ class InverterParams(_Validated):
     """
 
     V_dc: float = _p(48.0, "V_dc", "V", "DC bus voltage")
-    h: float = _p(0.2, "h", "A", "hysteresis band, total width")
+    h: float = _p(0.1, "h", "A", "hysteresis band, total width")
 
 
 @dataclass(frozen=True)
@@ -217,7 +217,7 @@ class IntegrationParams(_Validated):
 
     dt: float = _p(1e-6, "Δt", "s", "HF integration step")
     ripple_fraction: float = _p(
-        0.2, "r_h", "-", "max current change per electrical sub-step, fraction of h", "fraction"
+        0.4, "r_h", "-", "max current change per electrical sub-step, fraction of h", "fraction"
     )
 
 

@@ -1,0 +1,163 @@
+"""Calibration of the LF monitor model: its coefficients and the versioned file that holds them.
+
+The coefficients are those of the paper §4.2 (DESIGN §4.4): the shape-function coefficients
+k_FS, k_E (k_FT follows from them, see `Coefficients.k_FT`), the equivalent torque and back-EMF
+gains k_t,eq and k_e,eq, plus the inertia J_eq the LF model sees and the time constant τ_i of its
+simplified current loop. `emaphm calibrate` fits them with a GA against the HF twin
+(`emaphm.identification.calibrate`); the result ships as ``emaphm/data/calibration.json`` and is
+what the LF model loads by default.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError
+
+__all__ = ["COEFFICIENT_BOUNDS", "Calibration", "Coefficients", "default_calibration", "load_calibration"]
+
+FORMAT = "emaphm-lf-calibration"
+FORMAT_VERSION = 1
+
+# GA search bounds of each calibrated coefficient (SI)
+COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
+    "k_FS": (0.0, 100.0),  # [-]
+    "k_E": (0.0, 3.0),  # [-]
+    "k_t_eq": (0.10, 0.20),  # [N·m/A]
+    "k_e_eq": (0.05, 0.20),  # [V·s/rad]
+    "J_eq": (4.0e-5, 6.5e-5),  # [kg·m²]
+    "tau_i": (1e-6, 3e-4),  # [s]
+}
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """Equivalent single-phase motor and shape-function coefficients.
+
+    The defaults are the first guess before calibration: nameplate gains (k_t,eq = 1.5·p·ψ_m,
+    k_e,eq = p·ψ_m, J_eq = J_m + J_u/τ²), unit shape coefficients, a one-sample current lag.
+
+    k_FS : float  single-phase contribution of the short-circuit shape function [-]
+    k_E : float  eccentricity calibration coefficient [-]
+    k_t_eq : float  equivalent torque gain (healthy, φ_T = 1) [N·m/A]
+    k_e_eq : float  equivalent back-EMF coefficient (healthy) [V·s/rad]
+    J_eq : float  inertia at the motor shaft seen by the LF model [kg·m²]
+    tau_i : float  time constant of the simplified current loop [s]
+    """
+
+    k_FS: float = 1.0
+    k_E: float = 1.0
+    k_t_eq: float = 0.15
+    k_e_eq: float = 0.10
+    J_eq: float = 5.125e-5
+    tau_i: float = 1e-4
+
+    def __post_init__(self) -> None:
+        for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi):
+                raise InputError(
+                    f"calibration coefficient {name}={v!r} is outside its range [{lo:g}, {hi:g}]"
+                )
+
+    @property
+    def k_FT(self) -> float:
+        """Global short-circuit coefficient, k_FT = 1/(3 + 1.5·k_FS) so that a healthy φ_SC = 1.
+
+        k_FT multiplies k_t,eq and k_e,eq everywhere it appears, so the GA would only see their
+        products; fixing φ_SC(healthy) = 1 removes that degenerate direction and makes k_t,eq
+        the healthy torque constant.
+        """
+        return 1.0 / (3.0 + 1.5 * self.k_FS)
+
+    def as_vector(self) -> list[float]:
+        return [float(getattr(self, n)) for n in COEFFICIENT_BOUNDS]
+
+    @classmethod
+    def from_vector(cls, x: Any) -> Coefficients:
+        return cls(**{n: float(v) for n, v in zip(COEFFICIENT_BOUNDS, x, strict=True)})
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A calibration: coefficients, the LF step, and the record of how they were obtained."""
+
+    coefficients: Coefficients = field(default_factory=Coefficients)
+    n_lf: int = 1  # LF steps per sample period (1: the LF model steps at T_s = 100 µs)
+    record: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT,
+            "format_version": FORMAT_VERSION,
+            "coefficients": dataclasses.asdict(self.coefficients),
+            "derived": {"k_FT": self.coefficients.k_FT},
+            "n_lf": self.n_lf,
+            **self.record,
+        }
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the calibration file atomically (JSON)."""
+        from .io import atomic_path
+
+        p = Path(path)
+        if not p.parent.is_dir():
+            raise InputError(f"{p}: folder {p.parent} does not exist")
+        with atomic_path(p) as tmp:
+            tmp.write_text(json.dumps(self.to_json(), indent=2) + "\n")
+        return p
+
+
+def _parse(data: Any, where: str) -> Calibration:
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"{where}: not an emaphm LF calibration file")
+    if data.get("format_version") != FORMAT_VERSION:
+        raise InputError(
+            f"{where}: calibration format version {data.get('format_version')!r}, expected {FORMAT_VERSION}"
+        )
+    coeffs = data.get("coefficients")
+    if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
+        raise InputError(f"{where}: coefficients must be exactly {', '.join(COEFFICIENT_BOUNDS)}")
+    n_lf = data.get("n_lf")
+    if not isinstance(n_lf, int) or not 1 <= n_lf <= 100:
+        raise InputError(f"{where}: n_lf must be a whole number 1..100, got {n_lf!r}")
+    record = {
+        k: v
+        for k, v in data.items()
+        if k not in ("format", "format_version", "coefficients", "derived", "n_lf")
+    }
+    try:
+        return Calibration(Coefficients(**coeffs), n_lf, record)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def load_calibration(path: str | os.PathLike[str]) -> Calibration:
+    """Read a calibration file; a missing, unreadable or inconsistent file raises `InputError`."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{p}: no such calibration file")
+    try:
+        data = json.loads(p.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{p}: corrupt calibration file ({exc})") from None
+    return _parse(data, str(p))
+
+
+def default_calibration() -> Calibration:
+    """The calibration shipped with the package (``emaphm/data/calibration.json``)."""
+    ref = resources.files("emaphm") / "data" / "calibration.json"
+    try:
+        data = json.loads(ref.read_text())
+    except FileNotFoundError:
+        raise InputError("the packaged calibration file emaphm/data/calibration.json is missing") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"the packaged calibration file is corrupt ({exc})") from None
+    return _parse(data, "emaphm/data/calibration.json")

@@ -1,0 +1,90 @@
+"""The comparison pipeline shared by calibration and identification (DESIGN §5).
+
+Both signals (the measured or HF i_q and the LF current) go through the same zero-phase low-pass
+filter on the same time grid before they are compared:
+
+- **filter**: 2nd-order Butterworth at 150 Hz (*choice*), applied forward and backward
+  (`scipy.signal.sosfiltfilt`): zero phase, so no lag between the signals; it keeps the 1θ_e and
+  2θ_e fault harmonics (≤ 80 Hz on the FDI chirp) and removes the hysteresis ripple (kHz).
+- **grid**: the LF model's sample grid t_k = k/f_s; a reference trace on another grid is
+  interpolated onto it (`Comparison.from_trace`).
+- **NRMSE** (the calibration objective and the LF-vs-HF figure of merit):
+
+      NRMSE = ‖I_ref − I‖₂ ⁄ ‖I_ref − mean(I_ref)‖₂          (both filtered)
+
+  i.e. the RMS error over the standard deviation of the reference (MATLAB's goodnessOfFit
+  'NRMSE' cost). 0 is a perfect match; 1 is no better than the reference's mean.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.signal import butter, sosfiltfilt
+
+from ..errors import InputError
+
+__all__ = ["CUTOFF_HZ", "FILTER_ORDER", "Comparison", "lowpass", "nrmse"]
+
+CUTOFF_HZ = 150.0
+FILTER_ORDER = 2
+
+
+def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = -1) -> NDArray[np.float64]:
+    """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`."""
+    sos = butter(FILTER_ORDER, cutoff, fs=f_s, output="sos")
+    return sosfiltfilt(sos, np.asarray(x, dtype=np.float64), axis=axis)
+
+
+def nrmse(reference: ArrayLike, estimate: ArrayLike, *, axis: int = -1) -> NDArray[np.float64] | float:
+    """‖ref − est‖ ⁄ ‖ref − mean(ref)‖ along `axis` (inputs already filtered and on one grid)."""
+    ref = np.asarray(reference, dtype=np.float64)
+    est = np.asarray(estimate, dtype=np.float64)
+    scale = np.linalg.norm(ref - ref.mean(axis=axis, keepdims=True), axis=axis)
+    return np.linalg.norm(est - ref, axis=axis) / scale  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """A filtered reference current on the model grid, ready to score model currents against.
+
+    t : sample grid [s]; reference : filtered reference current [A]; f_s : sample rate [Hz].
+    """
+
+    t: NDArray[np.float64]
+    reference: NDArray[np.float64]
+    f_s: float
+
+    @classmethod
+    def from_signal(cls, t: ArrayLike, i_q: ArrayLike, f_s: float) -> Comparison:
+        """From a current sampled on the model grid t (unfiltered)."""
+        t = np.asarray(t, dtype=np.float64)
+        i_q = np.asarray(i_q, dtype=np.float64)
+        if t.shape != i_q.shape or t.ndim != 1:
+            raise InputError(f"t and i_q must be 1-D of equal length, got {t.shape} and {i_q.shape}")
+        if len(t) < 20:
+            raise InputError(f"the reference has {len(t)} samples; at least 20 are needed to filter it")
+        if not np.all(np.isfinite(i_q)):
+            raise InputError("the reference current contains NaN or inf")
+        return cls(t, lowpass(i_q, f_s), f_s)
+
+    @classmethod
+    def from_trace(cls, t_src: ArrayLike, i_q_src: ArrayLike, t_grid: ArrayLike, f_s: float) -> Comparison:
+        """From a trace on its own grid: linear interpolation onto the model grid, then the filter."""
+        t_src = np.asarray(t_src, dtype=np.float64)
+        t_grid = np.asarray(t_grid, dtype=np.float64)
+        if t_grid[0] < t_src[0] - 1e-12 or t_grid[-1] > t_src[-1] + 1e-12:
+            raise InputError(
+                f"the trace covers {t_src[0]:g}..{t_src[-1]:g} s, the model needs {t_grid[0]:g}..{t_grid[-1]:g} s"
+            )
+        return cls.from_signal(t_grid, np.interp(t_grid, t_src, np.asarray(i_q_src, dtype=np.float64)), f_s)
+
+    def filtered(self, currents: ArrayLike) -> NDArray[np.float64]:
+        """Model currents (shape (n,) or (m, n)) through the same filter."""
+        return lowpass(currents, self.f_s, axis=-1)
+
+    def nrmse(self, currents: ArrayLike) -> NDArray[np.float64] | float:
+        """NRMSE of model currents (unfiltered, shape (n,) or (m, n)) against the reference."""
+        return nrmse(self.reference, self.filtered(currents), axis=-1)

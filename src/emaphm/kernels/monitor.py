@@ -1,0 +1,155 @@
+"""Low-fidelity (LF) monitor model (paper §4.2, DESIGN §4): equivalent single-phase motor.
+
+Same command, same PID (`controller.pid_step`) and same drive train (`mechanics.mechanics_step`)
+as the HF twin; the three-phase stator and inverter are replaced by one equivalent RL circuit
+
+    L_eq·di/dt = u − R_eq·φ_R·i − k_e,eq·φ_E·ω_m,      T_m = k_t,eq·φ_T·i
+
+with a simplified current loop (a first-order lag of time constant τ_i towards i_q,ref, limited by
+the available voltage ±U_max) and the paper's two shape functions of the electrical angle:
+
+    φ_SC  = k_FT·{N_A[1 + k_FS·sin²(θ_e + π)] + N_B[1 + k_FS·sin²(θ_e + π/3)] + N_C[1 + k_FS·sin²(θ_e − π/3)]}   (eq. 1)
+    φ_ECC = 1 − k_E·ζ·cos(θ_e + φ_e)                                                                      (eq. 2)
+    φ_R = φ_SC,   φ_E = φ_T = φ_SC·φ_ECC                                                    (DESIGN §4.3)
+
+One simulation is one row of parameters (`LF_FIELDS`), so a whole GA generation is one call of
+`simulate_lf_many` (prange over rows), bit-identical to row-by-row `simulate_lf`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from ._jit import jit
+from .controller import ControllerPack, pid_step
+from .mechanics import MechanicsPack, mechanics_step
+from .sensors import quantise
+from .transforms import phase_directions
+
+# the layout of one row of LF parameters (SI)
+LF_FIELDS = (
+    # faults applied (DESIGN §2)
+    "F_S", "F_D", "B", "N_A", "N_B", "N_C", "zeta", "phi_e", "K_P",
+    # drive train and controller, as the HF twin
+    "J", "C", "tau", "eta", "theta_max", "T_load", "K_I", "K_D", "tau_D", "I_max", "T_s",
+    # position ADC [rad]
+    "lsb_theta", "fs_theta",
+    # equivalent motor and calibration coefficients
+    "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
+    # LF steps per sample period
+    "n_lf",
+)  # fmt: skip
+IDX = {name: j for j, name in enumerate(LF_FIELDS)}
+N_FIELDS = len(LF_FIELDS)
+
+AUX_COLUMNS = ("theta_u", "theta_m", "omega_m", "theta_e", "i_q_ref", "T_m")
+N_AUX = len(AUX_COLUMNS)
+
+(F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
+ LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX, N_LF) = range(N_FIELDS)  # fmt: skip
+
+
+@jit
+def phi_sc(sin_e, cos_e, N_a, N_b, N_c, k_FT, k_FS):  # type: ignore[no-untyped-def]
+    """Short-circuit shape function, paper eq. (1)."""
+    u_a, u_b, u_c = phase_directions(sin_e, cos_e)  # u_x² = sin²(θ_e + π), sin²(θ_e + π/3), sin²(θ_e − π/3)
+    return k_FT * (
+        N_a * (1.0 + k_FS * u_a * u_a) + N_b * (1.0 + k_FS * u_b * u_b) + N_c * (1.0 + k_FS * u_c * u_c)
+    )
+
+
+@jit
+def phi_ecc(sin_e, cos_e, kz_cos, kz_sin):  # type: ignore[no-untyped-def]
+    """Eccentricity shape function, paper eq. (2), cos(θ_e + φ_e) expanded.
+
+    kz_cos = k_E·ζ·cos φ_e and kz_sin = k_E·ζ·sin φ_e are constant over a run.
+    """
+    return 1.0 - (cos_e * kz_cos - sin_e * kz_sin)
+
+
+@jit
+def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U_max):  # type: ignore[no-untyped-def]
+    """Equivalent current after one step: a first-order lag towards i_ref, within the voltage ±U_max.
+
+    The lag (decay = exp(−dt/τ_i)) stands for the fast hysteresis loop. The voltage it needs,
+    u = L_eq·Δi/dt + R_eq·φ_R·i + k_e,eq·φ_E·ω_m, must stay within ±U_max, which bounds the step
+    to (±U_max − R_eq·φ_R·i − k_e,eq·φ_E·ω_m)·g with g = dt/L_eq [A/V] (explicit Euler).
+    """
+    drop = R_eq * phi_R * i + k_e_eq * phi_E * omega_m
+    di = (i_ref - i) * (1.0 - decay)
+    di_max = (U_max - drop) * g
+    di_min = (-U_max - drop) * g
+    if di > di_max:
+        di = di_max
+    elif di < di_min:
+        di = di_min
+    return i + di
+
+
+@jit
+def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
+    """Run the LF model for one parameter row `prm` (layout `LF_FIELDS`).
+
+    Writes i_out[k], the equivalent current averaged over the sample period ending at t_k (the
+    HF i_q convention), and, when aux has rows, the `AUX_COLUMNS` at t_k.
+    """
+    n = theta_cmd.shape[0]
+    record = aux.shape[0] > 0
+    cp = ControllerPack(prm[K_P], prm[K_I], prm[K_D], prm[TAU_D], prm[I_MAX], prm[T_S], prm[TAU])
+    mp = MechanicsPack(
+        prm[J], prm[C], prm[F_S], prm[F_D], prm[B], prm[TAU], prm[ETA], prm[THETA_MAX], prm[T_LOAD]
+    )
+    n_lf = int(prm[N_LF])
+    dt = prm[T_S] / n_lf
+    decay = math.exp(-dt / prm[TAU_I])
+    g = dt / prm[L_EQ]
+    p = prm[P]
+    kz_cos = prm[K_E] * prm[ZETA] * math.cos(prm[PHI_E])
+    kz_sin = prm[K_E] * prm[ZETA] * math.sin(prm[PHI_E])
+    theta_m = 0.0
+    omega_m = 0.0
+    theta_u = 0.0
+    i = 0.0
+    integral = 0.0
+    omega_f = 0.0
+    acc_i = 0.0
+    acc_T = 0.0
+    for k in range(n):
+        theta_meas = quantise(theta_u, prm[LSB_THETA], prm[FS_THETA])
+        i_q_ref, integral, omega_f = pid_step(theta_cmd[k], theta_meas, omega_m, integral, omega_f, cp)
+        i_out[k] = acc_i / n_lf
+        if record:
+            aux[k, 0] = theta_u
+            aux[k, 1] = theta_m
+            aux[k, 2] = omega_m
+            aux[k, 3] = p * theta_m
+            aux[k, 4] = i_q_ref
+            aux[k, 5] = acc_T / n_lf
+        if k == n - 1:
+            break
+        acc_i = 0.0
+        acc_T = 0.0
+        for _ in range(n_lf):
+            theta_e = p * theta_m
+            sin_e = math.sin(theta_e)
+            cos_e = math.cos(theta_e)
+            f_sc = phi_sc(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS])
+            f_ecc = phi_ecc(sin_e, cos_e, kz_cos, kz_sin)
+            i = current_loop_step(
+                i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
+            )
+            T_m = prm[K_T_EQ] * f_sc * f_ecc * i
+            theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp)
+            acc_i += i
+            acc_T += T_m
+
+
+@jit(parallel=True)
+def simulate_lf_many(theta_cmd, prm, i_out):  # type: ignore[no-untyped-def]
+    """One LF run per row of `prm` (shape (n_runs, N_FIELDS)) into i_out (shape (n_runs, n)), in parallel."""
+    no_aux = np.empty((0, N_AUX))
+    for r in prange(prm.shape[0]):
+        simulate_lf(theta_cmd, prm[r], i_out[r], no_aux)

@@ -1,0 +1,127 @@
+"""The low-fidelity monitor model (DESIGN §4): API layer over `kernels.monitor`."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .calibration import Calibration, Coefficients, default_calibration
+from .commands import Command
+from .faults import HEALTHY, as_fault_matrix, as_fault_vector, fault_parameter_columns
+from .kernels.monitor import AUX_COLUMNS, IDX, N_AUX, N_FIELDS, simulate_lf, simulate_lf_many
+from .kernels.sensors import adc
+from .models import _EmaModel, check_seed
+from .params import EmaParams
+from .results import SimResult
+
+__all__ = ["MonitorEma", "monitor_rows"]
+
+
+def monitor_rows(
+    K: NDArray[np.float64], params: EmaParams, coefficients: Sequence[Coefficients], n_lf: int
+) -> NDArray[np.float64]:
+    """LF parameter rows (layout `kernels.monitor.LF_FIELDS`) for fault rows K (validated, (m, 8)).
+
+    `coefficients` holds one `Coefficients` for all rows or one per row (calibration varies them).
+    """
+    m = K.shape[0]
+    if len(coefficients) not in (1, m):
+        raise ValueError(f"need 1 or {m} coefficient sets, got {len(coefficients)}")
+    tr, c, sens, mot = params.transmission, params.controller, params.sensors, params.motor
+    rows = np.empty((m, N_FIELDS))
+    for name, values in fault_parameter_columns(K, params).items():
+        rows[:, IDX[name]] = values
+    fixed = {
+        "C": tr.C, "tau": tr.tau, "eta": tr.eta, "theta_max": tr.theta_max, "T_load": tr.T_load,
+        "K_I": c.K_I, "K_D": c.K_D, "tau_D": c.tau_D, "I_max": c.I_max, "T_s": 1.0 / c.f_s,
+        "lsb_theta": sens.lsb_position, "fs_theta": sens.full_scale_position, "p": mot.p,
+        # DESIGN §4.2: the equivalent R and L are the phase values; they matter only near the
+        # voltage limit, the amplitude-invariant phase-voltage limit of the inverter V_dc/√3
+        "R_eq": mot.R_s, "L_eq": mot.L_s, "U_max": params.inverter.V_dc / math.sqrt(3.0), "n_lf": n_lf,
+    }  # fmt: skip
+    for name, value in fixed.items():
+        rows[:, IDX[name]] = value
+    cal = {
+        "k_FT": [x.k_FT for x in coefficients], "k_FS": [x.k_FS for x in coefficients],
+        "k_E": [x.k_E for x in coefficients], "k_t_eq": [x.k_t_eq for x in coefficients],
+        "k_e_eq": [x.k_e_eq for x in coefficients], "J": [x.J_eq for x in coefficients],
+        "tau_i": [x.tau_i for x in coefficients],
+    }  # fmt: skip
+    for name, values in cal.items():
+        rows[:, IDX[name]] = values
+    return rows
+
+
+class MonitorEma(_EmaModel):
+    """The low-fidelity monitor model (DESIGN §4): equivalent single-phase motor + shape functions.
+
+    Parameters
+    ----------
+    params : EmaParams
+        Nominal parameters: the LF model shares the drive train and controller with the HF twin.
+    command : Command
+        Position command; the FDI chirp by default.
+    calibration : Calibration
+        Coefficients of the equivalent motor; the packaged calibration by default.
+    """
+
+    model = "lf"
+
+    def __init__(
+        self,
+        params: EmaParams | None = None,
+        command: Command | None = None,
+        calibration: Calibration | None = None,
+    ) -> None:
+        super().__init__(params, command)
+        self.calibration = calibration if calibration is not None else default_calibration()
+
+    def rows(self, K: ArrayLike) -> NDArray[np.float64]:
+        """Validated LF parameter rows for the fault rows K."""
+        cal = self.calibration
+        return monitor_rows(as_fault_matrix(K), self.params, [cal.coefficients], cal.n_lf)
+
+    def simulate_many(self, K: ArrayLike, *, duration: float | None = None) -> NDArray[np.float64]:
+        """i_q [A] of one run per fault row of K, shape (m, n_samples): one parallel kernel call."""
+        _, theta_cmd = self.sample_grid(duration)
+        rows = self.rows(K)
+        out = np.empty((rows.shape[0], len(theta_cmd)))
+        simulate_lf_many(theta_cmd, rows, out)
+        return out
+
+    def simulate(
+        self,
+        faults: ArrayLike = HEALTHY,
+        *,
+        noise: bool = False,
+        seed: int = 0,
+        duration: float | None = None,
+    ) -> SimResult:
+        """Simulate the LF model. With `noise`, seeded measurement noise is added to i_q and θ_u
+        afterwards (the monitor model itself is deterministic; noise does not enter its loop)."""
+        k = as_fault_vector(faults)
+        seed = check_seed(seed)
+        t, theta_cmd = self.sample_grid(duration)
+        i_q = np.empty(len(t))
+        aux = np.empty((len(t), N_AUX))
+        simulate_lf(theta_cmd, self.rows(k)[0], i_q, aux)
+        col = {name: aux[:, j].copy() for j, name in enumerate(AUX_COLUMNS)}
+        theta_u = col["theta_u"].copy()
+        if noise:
+            sens = self.params.sensors
+            rng = np.random.default_rng(seed)
+            theta_noise = rng.normal(0.0, sens.sigma_position, len(t))
+            adc(col["theta_u"], theta_noise, sens.lsb_position, sens.full_scale_position, theta_u)
+            # Park of three independent phase errors of std σ_i has std √(2/3)·σ_i
+            i_q = i_q + rng.normal(0.0, math.sqrt(2.0 / 3.0) * sens.sigma_current, len(t))
+        signals = {
+            "theta_cmd": theta_cmd, "theta_u": theta_u, "i_q": i_q, "theta_e": col["theta_e"],
+            "omega_m": col["omega_m"], "i_q_ref": col["i_q_ref"], "T_m": col["T_m"], "theta_u_true": col["theta_u"],
+        }  # fmt: skip
+        cal = self.calibration
+        extra = {"calibration": {**cal.to_json(), "coefficients": dataclasses.asdict(cal.coefficients)}}
+        return SimResult(t=t, signals=signals, metadata=self.metadata(k, seed, noise, t, **extra))
