@@ -91,3 +91,40 @@ def test_demo_runs_and_writes_its_figure(tmp_path, capsys):
 def test_entry_point_is_installed():
     res = subprocess.run([sys.executable, "-m", "emaphm.cli", "--version"], capture_output=True, text=True)
     assert res.returncode == 0 and res.stdout.startswith("emaphm ")
+
+
+def test_simulate_lf_model(tmp_path, capsys):
+    out = tmp_path / "lf.csv"
+    code, _, _ = run_cli(["simulate", "--model", "lf", "--duration", "0.1", "--output", str(out)], capsys)
+    assert code == 0
+    r = read_trace(out)
+    assert r.metadata["model"] == "lf" and "calibration" in r.metadata
+    assert {"t", "theta_cmd", "theta_u", "i_q"} <= set(r.names)
+
+
+def test_calibrate_writes_a_loadable_file(tmp_path, capsys):
+    from emaphm.calibration import load_calibration
+
+    out = tmp_path / "cal.json"
+    code, _, err = run_cli(
+        ["calibrate", "--output", str(out), "--generations", "1", "--pop-size", "4", "--seed", "2"], capsys
+    )
+    assert code == 0 and "held out" in err
+    cal = load_calibration(out)
+    assert cal.record["seed"] == 2 and cal.record["settings"]["generations"] == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        (["calibrate", "--output", "cal.txt"], "must end in .json"),
+        (["calibrate", "--output", "no/such/dir/cal.json"], "does not exist"),
+        (["calibrate", "--workers", "-1"], "--workers"),
+        (["calibrate", "--generations", "0"], "generations"),
+    ],
+)
+def test_calibrate_bad_input(tmp_path, capsys, monkeypatch, args, reason):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli(args, capsys)
+    assert code == 2 and reason in err
+    assert list(tmp_path.iterdir()) == []

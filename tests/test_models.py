@@ -7,8 +7,8 @@ import pytest
 from scipy import signal
 
 import emaphm
-from conftest import IDEAL, RAMP, faults, frictionless
 from emaphm import HEALTHY
+from tests.conftest import IDEAL, RAMP, faults, frictionless
 
 
 def rms(x):

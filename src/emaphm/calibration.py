@@ -11,6 +11,7 @@ what the LF model loads by default.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import os
@@ -151,8 +152,9 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
     return _parse(data, str(p))
 
 
+@functools.lru_cache(maxsize=1)
 def default_calibration() -> Calibration:
-    """The calibration shipped with the package (``emaphm/data/calibration.json``)."""
+    """The calibration shipped with the package (``emaphm/data/calibration.json``), read once."""
     ref = resources.files("emaphm") / "data" / "calibration.json"
     try:
         data = json.loads(ref.read_text())

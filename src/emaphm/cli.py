@@ -116,9 +116,10 @@ def _set_workers(workers: int) -> None:
     """Threads for numba's parallel kernels: 0 means all cores."""
     import numba
 
-    if workers < 0 or workers > numba.config.NUMBA_NUM_THREADS:
-        raise InputError(f"--workers must be 0..{numba.config.NUMBA_NUM_THREADS}, got {workers}")
-    numba.set_num_threads(workers or numba.config.NUMBA_NUM_THREADS)
+    available = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
+    if workers < 0 or workers > available:
+        raise InputError(f"--workers must be 0..{available}, got {workers}")
+    numba.set_num_threads(workers or available)
 
 
 @contextmanager

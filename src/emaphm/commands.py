@@ -23,7 +23,9 @@ __all__ = ["COMMANDS", "Chirp", "Command", "Ramp", "Sine", "Step", "make_command
 class Command(Protocol):
     """A position command: ``command(t)`` gives θ_cmd [rad] at times t [s]."""
 
-    duration: float
+    @property
+    def duration(self) -> float:
+        """Length of the manoeuvre [s]."""
 
     def __call__(self, t: ArrayLike) -> NDArray[np.float64]: ...
 

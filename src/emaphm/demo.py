@@ -19,38 +19,9 @@ from rich.table import Table
 from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
 from .models import simulate
-from .results import SimResult
+from .plots import plot_response
 
-__all__ = ["plot_response", "run_demo"]
-
-
-def plot_response(healthy: SimResult, faulty: SimResult, path: Path) -> Path:
-    """Figure: command and user position, phase currents, and i_q healthy vs faulty."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True, layout="constrained")
-    t = faulty.t
-    ax[0].plot(t, faulty.theta_cmd, "k--", lw=1, label=r"$\theta_{cmd}$")
-    ax[0].plot(t, healthy.theta_u, lw=1.2, label=r"$\theta_u$ healthy")
-    ax[0].plot(t, faulty.theta_u, lw=1.2, label=r"$\theta_u$ Table 1 faults")
-    ax[0].set_ylabel("user position [rad]")
-    for name in ("i_a", "i_b", "i_c"):
-        ax[1].plot(t, faulty[name], lw=0.6, label=name)
-    ax[1].set_ylabel("phase current [A]")
-    ax[2].plot(t, healthy.i_q, lw=0.6, label=r"$i_q$ healthy")
-    ax[2].plot(t, faulty.i_q, lw=0.6, label=r"$i_q$ Table 1 faults")
-    ax[2].set_ylabel(r"$i_q$ [A]")
-    ax[2].set_xlabel("time [s]")
-    for a in ax:
-        a.legend(loc="upper right", fontsize=8, ncols=3)
-        a.grid(alpha=0.3)
-    fig.suptitle("High-fidelity EMA twin, FDI chirp (noise on)")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+__all__ = ["run_demo"]
 
 
 def _rms(x: np.ndarray) -> float:
@@ -106,7 +77,11 @@ def run_demo(
         f"two 1 s simulations took {wall:.2f} s (including any kernel compilation)."
     )
     output_dir.mkdir(parents=True, exist_ok=True)
-    figure = plot_response(healthy, faulty, output_dir / "hf_table1.png")
+    figure = plot_response(
+        {"healthy": healthy, "Table 1 faults": faulty},
+        output_dir / "hf_table1.png",
+        "High-fidelity EMA twin, FDI chirp (noise on)",
+    )
     console.print(f"figure: {figure}")
     console.print(
         "[yellow]Fault identification (LF monitor model + genetic algorithm) is not implemented yet; "

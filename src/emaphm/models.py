@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -46,6 +47,22 @@ def mechanics_pack(params: EmaParams, fp: FaultedParameters) -> MechanicsPack:
     return MechanicsPack(tr.J, tr.C, fp.F_S, fp.F_D, fp.B, tr.tau, tr.eta, tr.theta_max, tr.T_load)
 
 
+@functools.lru_cache(maxsize=32)
+def _sample_grid(
+    command: Command, f_s: float, duration: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    t = np.arange(round(duration * f_s) + 1) / f_s
+    theta_cmd = np.ascontiguousarray(command(t), dtype=np.float64)
+    t.setflags(write=False)
+    theta_cmd.setflags(write=False)
+    return t, theta_cmd
+
+
+@functools.lru_cache(maxsize=32)
+def _params_dict(params: EmaParams) -> dict[str, Any]:
+    return params.to_dict()
+
+
 class _EmaModel:
     """What both fidelities share: parameters, command, the sample grid and the result metadata."""
 
@@ -56,13 +73,14 @@ class _EmaModel:
         self.command = command if command is not None else Chirp()
 
     def sample_grid(self, duration: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Sample instants t_k = k/f_s [s] over `duration` (default: the command's) and θ_cmd(t_k) [rad]."""
+        """Sample instants t_k = k/f_s [s] over `duration` (default: the command's) and θ_cmd(t_k) [rad].
+
+        The arrays are cached and read-only.
+        """
         duration = float(self.command.duration if duration is None else duration)
         if not (math.isfinite(duration) and duration > 0):
             raise InputError(f"duration must be > 0 s, got {duration!r}")
-        f_s = self.params.controller.f_s
-        t = np.arange(round(duration * f_s) + 1) / f_s
-        return t, np.ascontiguousarray(self.command(t), dtype=np.float64)
+        return _sample_grid(self.command, self.params.controller.f_s, duration)  # type: ignore[arg-type]
 
     def metadata(
         self, k: NDArray[np.float64], seed: int, noise: bool, t: NDArray[np.float64], **extra: Any
@@ -75,7 +93,7 @@ class _EmaModel:
             "noise": bool(noise),
             "duration": float(t[-1]),
             "command": {"type": type(self.command).__name__.lower(), **vars(self.command)},
-            "params": self.params.to_dict(),
+            "params": {group: dict(values) for group, values in _params_dict(self.params).items()},
             **extra,
             "version": __version__,
         }

@@ -45,14 +45,14 @@ def monitor_rows(
     }  # fmt: skip
     for name, value in fixed.items():
         rows[:, IDX[name]] = value
-    cal = {
+    cal: dict[str, list[float]] = {
         "k_FT": [x.k_FT for x in coefficients], "k_FS": [x.k_FS for x in coefficients],
         "k_E": [x.k_E for x in coefficients], "k_t_eq": [x.k_t_eq for x in coefficients],
         "k_e_eq": [x.k_e_eq for x in coefficients], "J": [x.J_eq for x in coefficients],
         "tau_i": [x.tau_i for x in coefficients],
     }  # fmt: skip
-    for name, values in cal.items():
-        rows[:, IDX[name]] = values
+    for name, per_row in cal.items():
+        rows[:, IDX[name]] = per_row
     return rows
 
 

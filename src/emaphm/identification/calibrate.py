@@ -115,10 +115,10 @@ def scenario_nrmse(
     rows = monitor_rows(np.tile(K, (n_c, 1)), params, [c for c in coefficients for _ in range(n_s)], n_lf)
     currents = np.empty((rows.shape[0], len(theta_cmd)))
     simulate_lf_many(theta_cmd, rows, currents)
-    currents = currents.reshape(n_c, n_s, -1)
+    by_case = currents.reshape(n_c, n_s, -1)
     out = np.empty((n_c, n_s))
     for s, ref in enumerate(references):
-        out[:, s] = ref.nrmse(currents[:, s, :])
+        out[:, s] = ref.nrmse(by_case[:, s, :])
     return out
 
 
@@ -137,7 +137,8 @@ class _CalibrationProblem(Problem):  # type: ignore[misc]
 class _Report(Callback):  # type: ignore[misc]
     def __init__(self, progress: Progress | None, generations: int) -> None:
         super().__init__()
-        self.progress, self.generations, self.history = progress, generations, []
+        self.progress, self.generations = progress, generations
+        self.history: list[float] = []
 
     def notify(self, algorithm: Any) -> None:
         self.history.append(float(algorithm.pop.get("F").min()))
@@ -164,12 +165,12 @@ def calibrate(
     scenario sets, the NRMSE of each, the seed, the settings, the GA history and the version.
     """
     seed = check_seed(seed)
-    for name, value, lo in (("pop_size", pop_size, 4), ("generations", generations, 1), ("n_lf", n_lf, 1)):
-        if not isinstance(value, int) or value < lo:
-            raise InputError(f"{name} must be a whole number >= {lo}, got {value!r}")
+    for name, value, least in (("pop_size", pop_size, 4), ("generations", generations, 1), ("n_lf", n_lf, 1)):
+        if not isinstance(value, int) or value < least:
+            raise InputError(f"{name} must be a whole number >= {least}, got {value!r}")
     params = params if params is not None else EmaParams()
-    command = command if command is not None else Chirp()
-    hf = HighFidelityEma(params, command)
+    hf = HighFidelityEma(params, command if command is not None else Chirp())
+    command = hf.command
     start = time.perf_counter()
     fit_refs = hf_references(fit, hf, noise=False, seed=seed, progress=progress)
     check_refs = hf_references(check, hf, noise=False, seed=seed, progress=progress)
@@ -185,7 +186,8 @@ def calibrate(
         _CalibrationProblem(objective), GA(pop_size=pop_size), ("n_gen", generations),
         seed=seed, verbose=False, callback=report,
     )  # fmt: skip
-    best = Coefficients.from_vector(np.clip(res.X, *zip(*COEFFICIENT_BOUNDS.values(), strict=True)))
+    lo, hi = (np.array(b) for b in zip(*COEFFICIENT_BOUNDS.values(), strict=True))
+    best = Coefficients.from_vector(np.clip(res.X, lo, hi))
     fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, theta_cmd, n_lf)[0]
     check_nrmse = scenario_nrmse([best], check, check_refs, params, theta_cmd, n_lf)[0]
     check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, theta_cmd, n_lf)[0]

@@ -1,0 +1,60 @@
+"""Shape functions (paper eqs. 1 and 2) and the LF population kernel."""
+
+import numpy as np
+import pytest
+
+from emaphm.kernels.monitor import N_AUX, phi_ecc, phi_sc, simulate_lf, simulate_lf_many
+from emaphm.monitor import MonitorEma
+
+THETA = np.linspace(0, 2 * np.pi, 720, endpoint=False)
+
+
+def harmonic(y, order):
+    """Complex amplitude of the order·θ term of y(θ) over one electrical turn."""
+    return 2 * np.mean(y * np.exp(-1j * order * THETA))
+
+
+@pytest.mark.parametrize(("k_FT", "k_FS"), [(1.0, 0.0), (0.2, 1.0), (0.0078, 83.0), (3.0, 0.4)])
+def test_healthy_short_circuit_shape_is_constant(k_FT, k_FS):
+    # sin²θ + sin²(θ + π/3) + sin²(θ − π/3) = 3/2
+    y = phi_sc(np.sin(THETA), np.cos(THETA), 1.0, 1.0, 1.0, k_FT, k_FS)
+    np.testing.assert_allclose(y, k_FT * (3 + 1.5 * k_FS), rtol=1e-13)
+
+
+def test_one_phase_short_gives_a_2theta_term_at_that_phase():
+    s, c = np.sin(THETA), np.cos(THETA)
+    terms = []
+    for N in ([0.7, 1, 1], [1, 0.7, 1], [1, 1, 0.7]):
+        y = phi_sc(s, c, *N, 0.1, 2.0)
+        assert abs(harmonic(y, 1)) < 1e-12 and abs(harmonic(y, 3)) < 1e-12  # only DC and 2θ
+        terms.append(harmonic(y, 2))
+    amps = np.abs(terms)
+    np.testing.assert_allclose(amps, amps[0], rtol=1e-10)  # same size in every phase
+    # sin²(θ + π) = (1 − cos 2θ)/2, so removing turns from A leaves +cos 2θ (0°); the sin² terms of
+    # B and C are those of A shifted by 2π/3 in 2θ: cos(2θ + 2π/3), cos(2θ − 2π/3)
+    assert np.degrees(np.angle(terms[0])) == pytest.approx(0.0, abs=1e-9)
+    assert np.degrees(np.angle(terms[1] / terms[0])) == pytest.approx(120.0)
+    assert np.degrees(np.angle(terms[2] / terms[1])) == pytest.approx(120.0)
+
+
+@pytest.mark.parametrize("phi_e", [0.0, 1.0, 4.0])
+def test_eccentricity_gives_a_1theta_term_at_its_phase(phi_e):
+    y = phi_ecc(np.sin(THETA), np.cos(THETA), 0.3 * np.cos(phi_e), 0.3 * np.sin(phi_e))  # k_E·ζ = 0.3
+    h1 = harmonic(y, 1)
+    assert abs(h1) == pytest.approx(0.3)
+    assert np.angle(-h1) == pytest.approx(np.angle(np.exp(1j * phi_e)))  # −0.3·cos(θ + φ_e)
+    assert np.mean(y) == pytest.approx(1.0) and abs(harmonic(y, 2)) < 1e-12
+
+
+def test_population_kernel_is_bit_identical_to_single_runs():
+    m = MonitorEma()
+    K = np.random.default_rng(5).uniform(0, 1, (9, 8))
+    rows = m.rows(K)
+    _, theta_cmd = m.sample_grid(0.3)
+    many = np.empty((9, len(theta_cmd)))
+    simulate_lf_many(theta_cmd, rows, many)
+    single = np.empty(len(theta_cmd))
+    for r in range(9):
+        simulate_lf(theta_cmd, rows[r], single, np.empty((0, N_AUX)))
+        np.testing.assert_array_equal(single, many[r])
+    assert not np.array_equal(many[0], many[1])
