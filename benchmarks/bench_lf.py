@@ -84,6 +84,7 @@ def main() -> None:
     print(f"  speed-up 2 threads vs 1: median {statistics.median(ratios):.2f}x over 9 interleaved rounds "
           f"(range {min(ratios):.2f}-{max(ratios):.2f})")  # fmt: skip
 
+
 def _timed(fn, *a) -> float:  # type: ignore[no-untyped-def]
     t0 = time.perf_counter()
     fn(*a)

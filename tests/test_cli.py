@@ -81,11 +81,12 @@ def test_no_noise_flag(tmp_path, capsys):
     np.testing.assert_array_equal(a.i_q, b.i_q)
 
 
-def test_demo_runs_and_writes_its_figure(tmp_path, capsys):
-    code, out, _ = run_cli(["demo", "--output-dir", str(tmp_path / "demo")], capsys)
+def test_demo_runs_and_writes_its_figures(tmp_path, capsys):
+    code, out, _ = run_cli(["demo", "--output-dir", str(tmp_path / "demo"), "--runs", "1"], capsys)
     assert code == 0
-    assert (tmp_path / "demo" / "hf_table1.png").stat().st_size > 10_000
-    assert "0.5003" in out and "not implemented" in out
+    for name in ("hf_table1.png", "identified_current.png", "convergence.png", "identified_vs_true.png"):
+        assert (tmp_path / "demo" / name).stat().st_size > 10_000
+    assert "0.5003" in out and "%err" in out and "the paper" in out
 
 
 def test_entry_point_is_installed():
@@ -128,3 +129,78 @@ def test_calibrate_bad_input(tmp_path, capsys, monkeypatch, args, reason):
     code, _, err = run_cli(args, capsys)
     assert code == 2 and reason in err
     assert list(tmp_path.iterdir()) == []
+
+
+# ---- identify ---------------------------------------------------------------------------------
+
+FAST = ["--pop-size", "16", "--generations", "5", "--no-polish"]
+
+
+def test_identify_json(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "result.json"
+    code, stdout, _ = run_cli(
+        [
+            "identify",
+            "--true-faults",
+            "0.3,0,0,0,0,0,0,0.5",
+            "--json",
+            "--seed",
+            "1",
+            "--output",
+            str(out),
+            *FAST,
+        ],
+        capsys,
+    )
+    assert code == 0
+    data = json.loads(stdout)
+    for key in ("estimate", "fault_names", "truth", "percent_error", "fitness", "evaluations", "wall_time_s",
+                "seed", "optimizer", "version", "detected"):  # fmt: skip
+        assert key in data
+    assert len(data["estimate"]) == 8 and data["percent_error"] > 0
+    assert json.loads(out.read_text())["estimate"] == data["estimate"]
+
+
+def test_identify_from_a_reference_trace(tmp_path, capsys):
+    import json
+
+    trace = tmp_path / "m.h5"
+    run_cli(["simulate", "--faults", "0,0.3,0,0,0,0,0,0.5", "--output", str(trace)], capsys)
+    code, stdout, _ = run_cli(["identify", "--reference", str(trace), "--json", *FAST], capsys)
+    data = json.loads(stdout)
+    assert code == 0 and data["truth"] is None and data["percent_error"] is None
+
+
+def _write_bad_traces(d):
+    (d / "corrupt.h5").write_bytes(b"garbage")
+    (d / "nan.csv").write_text(
+        "t,theta_cmd,theta_u,i_q\n" + "".join(f"{j / 1e4},0,0,{'nan' if j == 5 else 0}\n" for j in range(300))
+    )
+    (d / "few.csv").write_text("t,theta_cmd,theta_u,i_q\n" + "".join(f"{j / 1e4},0,0,0\n" for j in range(50)))
+    (d / "nocmd.csv").write_text("t,theta_u,i_q\n" + "".join(f"{j / 1e4},0,0\n" for j in range(300)))
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        (["identify"], "exactly one of"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--reference", "x.h5"], "exactly one of"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--optimizer", "sa"], "unknown optimizer"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,1.5"], "--true-faults"),
+        (["identify", "--reference", "missing.h5"], "no such file"),
+        (["identify", "--reference", "corrupt.h5"], "cannot read"),
+        (["identify", "--reference", "nan.csv"], "NaN"),
+        (["identify", "--reference", "few.csv"], "at least 200"),
+        (["identify", "--reference", "nocmd.csv"], "theta_cmd"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--output", "r.txt"], "--output"),
+    ],
+)
+def test_identify_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, monkeypatch, args, reason):
+    monkeypatch.chdir(tmp_path)
+    _write_bad_traces(tmp_path)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    code, stdout, err = run_cli(args, capsys)
+    assert code == 2 and reason in err and len(err.strip().splitlines()) == 1
+    assert stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == before

@@ -25,7 +25,7 @@ from .errors import InputError
 __all__ = ["COEFFICIENT_BOUNDS", "Calibration", "Coefficients", "default_calibration", "load_calibration"]
 
 FORMAT = "emaphm-lf-calibration"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 # GA search bounds of each calibrated coefficient (SI)
 COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -35,6 +35,10 @@ COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
     "k_e_eq": (0.05, 0.20),  # [V·s/rad]
     "J_eq": (4.0e-5, 6.5e-5),  # [kg·m²]
     "tau_i": (1e-6, 3e-4),  # [s]
+    "k_H": (-0.1, 0.1),  # [-]
+    "delta_0": (0.0, 0.02),  # [A]
+    "delta_1": (0.0, 0.1),  # [A]
+    "omega_H": (0.1, 20.0),  # [rad/s]
 }
 
 
@@ -43,7 +47,8 @@ class Coefficients:
     """Equivalent single-phase motor and shape-function coefficients.
 
     The defaults are the first guess before calibration: nameplate gains (k_t,eq = 1.5·p·ψ_m,
-    k_e,eq = p·ψ_m, J_eq = J_m + J_u/τ²), unit shape coefficients, a one-sample current lag.
+    k_e,eq = p·ψ_m, J_eq = J_m + J_u/τ²), unit shape coefficients, a one-sample current lag and
+    no current-loop surrogate error.
 
     k_FS : float  single-phase contribution of the short-circuit shape function [-]
     k_E : float  eccentricity calibration coefficient [-]
@@ -51,6 +56,10 @@ class Coefficients:
     k_e_eq : float  equivalent back-EMF coefficient (healthy) [V·s/rad]
     J_eq : float  inertia at the motor shaft seen by the LF model [kg·m²]
     tau_i : float  time constant of the simplified current loop [s]
+    k_H : float  2θ_e ripple of the loop's current per unit of lost turns [-]
+    delta_0 : float  loop offset of the measured current, healthy [A]
+    delta_1 : float  growth of that offset per unit of lost turns Σ(1 − N_x) [A]
+    omega_H : float  motor speed over which the offset reverses with the rotation [rad/s]
     """
 
     k_FS: float = 1.0
@@ -59,6 +68,10 @@ class Coefficients:
     k_e_eq: float = 0.10
     J_eq: float = 5.125e-5
     tau_i: float = 1e-4
+    k_H: float = 0.0
+    delta_0: float = 0.0
+    delta_1: float = 0.0
+    omega_H: float = 1.0
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in COEFFICIENT_BOUNDS.items():

@@ -17,7 +17,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
 
-__all__ = ["COMMANDS", "Chirp", "Command", "Ramp", "Sine", "Step", "make_command"]
+__all__ = [
+    "COMMANDS",
+    "Chirp",
+    "Command",
+    "Ramp",
+    "SampledCommand",
+    "Sine",
+    "Step",
+    "command_record",
+    "make_command",
+]
 
 
 class Command(Protocol):
@@ -113,6 +123,39 @@ class Sine(_Checked):
     def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
         t = np.asarray(t, dtype=np.float64)
         return self.amplitude * np.sin(2.0 * np.pi * self.frequency * t)
+
+
+class SampledCommand:
+    """θ_cmd recorded in a trace: linear interpolation of samples (t [s], theta [rad]).
+
+    Used to replay the command of a measured or written trace through the monitor model.
+    """
+
+    def __init__(self, t: ArrayLike, theta: ArrayLike) -> None:
+        self.t = np.array(t, dtype=np.float64)
+        self.theta = np.array(theta, dtype=np.float64)
+        if self.t.ndim != 1 or self.t.shape != self.theta.shape or len(self.t) < 2:
+            raise InputError("a sampled command needs t and theta of equal length >= 2")
+        if not (np.all(np.isfinite(self.t)) and np.all(np.isfinite(self.theta))):
+            raise InputError("the sampled command contains NaN or inf")
+        if self.t[0] != 0.0 or np.any(np.diff(self.t) <= 0):
+            raise InputError("the sampled command's time must start at 0 s and increase")
+        self.t.setflags(write=False)
+        self.theta.setflags(write=False)
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        return np.interp(np.asarray(t, dtype=np.float64), self.t, self.theta)
+
+
+def command_record(command: Command) -> dict[str, Any]:
+    """A JSON-ready description of a command, for result metadata."""
+    if isinstance(command, SampledCommand):
+        return {"type": "sampled", "samples": len(command.t), "duration": command.duration}
+    return {"type": type(command).__name__.lower(), **vars(command)}
 
 
 COMMANDS: dict[str, type] = {"chirp": Chirp, "step": Step, "ramp": Ramp, "sine": Sine}

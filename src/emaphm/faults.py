@@ -94,16 +94,16 @@ def as_fault_vector(k: ArrayLike, *, name: str = "fault vector") -> NDArray[np.f
     return arr
 
 
-def parse_faults(text: str) -> NDArray[np.float64]:
-    """Parse the CLI form ``K1,...,K8`` into a validated fault vector."""
+def parse_faults(text: str, *, option: str = "--faults") -> NDArray[np.float64]:
+    """Parse the CLI form ``K1,...,K8`` into a validated fault vector (errors name `option`)."""
     parts = [p.strip() for p in text.split(",")]
     values: list[float] = []
     for i, part in enumerate(parts):
         try:
             values.append(float(part))
         except ValueError:
-            raise InputError(f"--faults: value {i + 1} ({part!r}) is not a number") from None
-    return as_fault_vector(values, name="--faults")
+            raise InputError(f"{option}: value {i + 1} ({part!r}) is not a number") from None
+    return as_fault_vector(values, name=option)
 
 
 @dataclass(frozen=True)

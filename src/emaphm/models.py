@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._version import __version__
-from .commands import Chirp, Command
+from .commands import Chirp, Command, command_record
 from .errors import InputError
 from .faults import HEALTHY, FaultedParameters, apply_faults, as_fault_vector
 from .kernels.controller import ControllerPack
@@ -92,7 +92,7 @@ class _EmaModel:
             "seed": seed,
             "noise": bool(noise),
             "duration": float(t[-1]),
-            "command": {"type": type(self.command).__name__.lower(), **vars(self.command)},
+            "command": command_record(self.command),
             "params": {group: dict(values) for group, values in _params_dict(self.params).items()},
             **extra,
             "version": __version__,

@@ -49,7 +49,9 @@ def monitor_rows(
         "k_FT": [x.k_FT for x in coefficients], "k_FS": [x.k_FS for x in coefficients],
         "k_E": [x.k_E for x in coefficients], "k_t_eq": [x.k_t_eq for x in coefficients],
         "k_e_eq": [x.k_e_eq for x in coefficients], "J": [x.J_eq for x in coefficients],
-        "tau_i": [x.tau_i for x in coefficients],
+        "tau_i": [x.tau_i for x in coefficients], "k_H": [x.k_H for x in coefficients],
+        "delta_0": [x.delta_0 for x in coefficients], "delta_1": [x.delta_1 for x in coefficients],
+        "omega_H": [x.omega_H for x in coefficients],
     }  # fmt: skip
     for name, per_row in cal.items():
         rows[:, IDX[name]] = per_row

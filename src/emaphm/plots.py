@@ -68,3 +68,61 @@ def plot_calibration(
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_fit(
+    t: np.ndarray, measured: np.ndarray, identified: np.ndarray, path: Path, f_s: float = 1e4
+) -> Path:
+    """Measured vs identified current (both filtered) and their residual."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
+    m, i = lowpass(measured, f_s), lowpass(identified, f_s)
+    ax[0].plot(t, measured, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
+    ax[0].plot(t, m, "k", lw=1.0, label="measured, filtered")
+    ax[0].plot(t, i, "C1", lw=1.0, label="LF model with the identified faults")
+    ax[0].set_ylabel("current [A]")
+    ax[0].legend(loc="upper right", fontsize=8)
+    ax[1].plot(t, m - i, "C3", lw=0.8)
+    ax[1].set_ylabel("residual [A]")
+    ax[1].set_xlabel("time [s]")
+    for a in ax:
+        a.grid(alpha=0.3)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
+    """Best fitness per generation of each run (log scale)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+    for label, h in histories.items():
+        ax.semilogy(np.arange(1, len(h) + 1), h, lw=1.2, label=label)
+    ax.set_xlabel("generation (global search, then polish)")
+    ax.set_ylabel("best fitness, eq. (3) [A²]")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_vectors(
+    truth: np.ndarray, estimates: Mapping[str, np.ndarray], names: tuple[str, ...], path: Path
+) -> Path:
+    """Identified vs true fault vector, one group of bars per fault."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9, 4), layout="constrained")
+    n = len(estimates) + 1
+    width = 0.8 / n
+    x = np.arange(len(truth))
+    ax.bar(x - 0.4 + width / 2, truth, width, color="k", label="true")
+    for j, (label, k) in enumerate(estimates.items(), start=1):
+        ax.bar(x - 0.4 + width / 2 + j * width, k, width, label=label)
+    ax.set_xticks(x, [f"k{i + 1}\n{nm}" for i, nm in enumerate(names)], fontsize=7)
+    ax.set_ylabel("fault value [-]")
+    ax.legend(fontsize=7, ncols=3)
+    ax.grid(alpha=0.3, axis="y")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -25,7 +25,7 @@ from pymoo.optimize import minimize
 
 from .._version import __version__
 from ..calibration import COEFFICIENT_BOUNDS, Calibration, Coefficients
-from ..commands import Chirp, Command
+from ..commands import Chirp, Command, command_record
 from ..errors import InputError
 from ..faults import HEALTHY, as_fault_vector
 from ..kernels.monitor import simulate_lf_many
@@ -149,8 +149,8 @@ class _Report(Callback):  # type: ignore[misc]
 def calibrate(
     *,
     seed: int = 1,
-    pop_size: int = 40,
-    generations: int = 40,
+    pop_size: int = 60,
+    generations: int = 150,
     n_lf: int = 1,
     params: EmaParams | None = None,
     command: Command | None = None,
@@ -214,7 +214,7 @@ def calibrate(
             "nrmse": "||I_HF - I_LF|| / ||I_HF - mean(I_HF)||, both filtered",
             "filter": f"Butterworth order {FILTER_ORDER}, {CUTOFF_HZ:g} Hz, zero phase (sosfiltfilt)",
             "bounds": {k: list(v) for k, v in COEFFICIENT_BOUNDS.items()},
-            "command": {"type": type(command).__name__.lower(), **vars(command)},
+            "command": command_record(command),
             "params": params.to_dict(),
             "wall_time_s": round(time.perf_counter() - start, 2),
         },

@@ -39,6 +39,8 @@ LF_FIELDS = (
     "lsb_theta", "fs_theta",
     # equivalent motor and calibration coefficients
     "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
+    # current-loop surrogate of the three-phase hysteresis loop's error (calibrated)
+    "k_H", "delta_0", "delta_1", "omega_H",
     # LF steps per sample period
     "n_lf",
 )  # fmt: skip
@@ -49,7 +51,8 @@ AUX_COLUMNS = ("theta_u", "theta_m", "omega_m", "theta_e", "i_q_ref", "T_m")
 N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
- LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX, N_LF) = range(N_FIELDS)  # fmt: skip
+ LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX,
+ K_H, DELTA_0, DELTA_1, OMEGA_H, N_LF) = range(N_FIELDS)  # fmt: skip
 
 
 @jit
@@ -68,6 +71,21 @@ def phi_ecc(sin_e, cos_e, kz_cos, kz_sin):  # type: ignore[no-untyped-def]
     kz_cos = k_E·ζ·cos φ_e and kz_sin = k_E·ζ·sin φ_e are constant over a run.
     """
     return 1.0 - (cos_e * kz_cos - sin_e * kz_sin)
+
+
+@jit
+def phi_hyst(sin_e, cos_e, N_a, N_b, N_c, k_H):  # type: ignore[no-untyped-def]
+    """Current-loop shape function: φ_H = 1 + k_H·Σ_x (1 − N_x)·cos(2θ_e − 2γ_x).
+
+    A surrogate, like eqs. (1)–(2): with a shorted phase the three-phase hysteresis loop delivers
+    a current whose magnitude ripples at 2θ_e in step with that phase (cos(2θ_e − 2γ_x) = 1 − 2u_x²).
+    """
+    u_a, u_b, u_c = phase_directions(sin_e, cos_e)
+    return 1.0 + k_H * (
+        (1.0 - N_a) * (1.0 - 2.0 * u_a * u_a)
+        + (1.0 - N_b) * (1.0 - 2.0 * u_b * u_b)
+        + (1.0 - N_c) * (1.0 - 2.0 * u_c * u_c)
+    )
 
 
 @jit
@@ -95,6 +113,10 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
 
     Writes i_out[k], the equivalent current averaged over the sample period ending at t_k (the
     HF i_q convention), and, when aux has rows, the `AUX_COLUMNS` at t_k.
+
+    The loop state i follows the demand (first-order lag); the motor carries, and the sensors
+    measure, i_m = i·φ_H − δ_H·tanh(ω_m/ω_H): the calibrated surrogate of the three-phase
+    hysteresis loop's own error, which grows with the phase unbalance (monitor-model.md §1).
     """
     n = theta_cmd.shape[0]
     record = aux.shape[0] > 0
@@ -107,6 +129,9 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     decay = math.exp(-dt / prm[TAU_I])
     g = dt / prm[L_EQ]
     p = prm[P]
+    # hysteresis-loop offset δ_H = δ_0 + δ_1·Σ(1 − N_x): the measured current trails by δ_H·tanh(ω_m/ω_H)
+    delta_H = prm[DELTA_0] + prm[DELTA_1] * (3.0 - prm[N_A] - prm[N_B] - prm[N_C])
+    inv_omega_H = 1.0 / prm[OMEGA_H]
     kz_cos = prm[K_E] * prm[ZETA] * math.cos(prm[PHI_E])
     kz_sin = prm[K_E] * prm[ZETA] * math.sin(prm[PHI_E])
     theta_m = 0.0
@@ -141,9 +166,13 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             i = current_loop_step(
                 i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
             )
-            T_m = prm[K_T_EQ] * f_sc * f_ecc * i
+            # the current the motor carries and the sensors measure: the loop's surrogate error on top
+            i_m = i * phi_hyst(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_H]) - delta_H * math.tanh(
+                omega_m * inv_omega_H
+            )
+            T_m = prm[K_T_EQ] * f_sc * f_ecc * i_m
             theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp)
-            acc_i += i
+            acc_i += i_m
             acc_T += T_m
 
 

@@ -1,0 +1,54 @@
+"""eq. (3) and the comparison pipeline."""
+
+import numpy as np
+import pytest
+
+from emaphm import InputError
+from emaphm.identification.fitness import Fitness
+from emaphm.identification.signals import Comparison, lowpass, nrmse
+
+F_S = 1e4
+T = np.arange(5001) / F_S
+
+
+def test_lowpass_is_zero_phase_and_passes_the_fault_band():
+    x = np.sin(2 * np.pi * 40 * T)  # a 2θ_e-like 40 Hz component
+    y = lowpass(x, F_S)
+    inner = slice(500, -500)
+    assert np.max(np.abs(y[inner] - x[inner])) < 0.1  # 150 Hz 2nd order: −0.3 dB at 40 Hz, no lag
+    ripple = np.sin(2 * np.pi * 2000 * T)  # hysteresis ripple is removed
+    assert np.max(np.abs(lowpass(ripple, F_S)[inner])) < 0.02
+
+
+def test_nrmse_definition():
+    ref = np.sin(2 * np.pi * 4 * T)  # two whole cycles: zero mean (to one sample)
+    assert nrmse(ref, ref) == 0.0
+    assert nrmse(ref, np.full_like(ref, ref.mean())) == pytest.approx(1.0)
+    assert nrmse(ref, 1.1 * ref) == pytest.approx(0.1, rel=1e-3)
+
+
+def test_fitness_is_zero_for_a_perfect_match_and_grows_with_error():
+    i = 0.3 * np.sin(2 * np.pi * 4 * T)
+    f = Fitness(Comparison.from_signal(T, i, F_S))
+    assert f(i) == pytest.approx(0.0, abs=1e-20)
+    errs = f(np.stack([i + 0.01, i + 0.02]))
+    assert errs[1] == pytest.approx(4 * errs[0], rel=1e-6)  # quadratic in the residual
+
+
+def test_slope_weighting_discounts_steep_samples():
+    # the same residual counts less where the measured current is steep (A/s)
+    i = np.where(T < 0.25, 0.0, 1.0) * 0.5  # a step: steep after filtering
+    f = Fitness(Comparison.from_signal(T, i, F_S))
+    steep = int(np.argmin(f.weights))
+    assert f.weights[steep] < 0.1 and f.weights[100] == pytest.approx(1.0)
+    assert Fitness(Comparison.from_signal(T, i, F_S), "ms").weights.min() > 0.9  # A/ms: ~plain LS
+    with pytest.raises(InputError, match="slope unit"):
+        Fitness(Comparison.from_signal(T, i, F_S), "h")
+
+
+def test_reference_on_another_grid_is_interpolated():
+    t_src = np.arange(2501) / 5e3
+    c = Comparison.from_trace(t_src, np.sin(2 * np.pi * 3 * t_src), T, F_S)
+    assert c.reference.shape == T.shape
+    with pytest.raises(InputError, match="covers"):
+        Comparison.from_trace(t_src[:100], np.zeros(100), T, F_S)
