@@ -88,3 +88,15 @@ def test_identify_bad_input(tmp_path):
     short = emaphm.simulate(emaphm.HEALTHY, duration=0.01)
     with pytest.raises(InputError, match="at least 200"):
         identify(reference=short)
+
+
+def test_phase_map_wraps_and_keeps_every_phase_away_from_the_bounds():
+    from emaphm.identification.identify import search_to_faults
+
+    x = np.tile(np.linspace(0, 1, 201)[:, None], (1, 8))
+    k = search_to_faults(x)
+    np.testing.assert_array_equal(np.delete(k, 6, axis=1), np.delete(x, 6, axis=1))  # others as is
+    assert k[:, 6].min() >= 0.0 and k[:, 6].max() < 1.0
+    # every phase in [0, 1) is reached from some x7 in [0.25, 0.75], away from the bounds
+    inner = k[(x[:, 6] >= 0.25) & (x[:, 6] <= 0.75), 6]
+    assert inner.min() == 0.0 and inner.max() >= 0.99 - 1e-12  # grid step 0.01 in k7
