@@ -22,12 +22,9 @@ import time
 import numpy as np
 
 import emaphm
-from emaphm.faults import FAULT_NAMES, TABLE1_REFERENCE
+from emaphm.faults import FAULT_NAMES, TABLE1_REFERENCE, random_faults
 from emaphm.identification.identify import identify
 from emaphm.identification.metrics import absolute_errors, percent_error
-
-LOW = np.array([0, 0, 0, 0, 0, 0, 0, 0.3])
-HIGH = np.array([0.6, 0.6, 0.5, 0.5, 0.5, 0.3, 1.0, 0.7])
 
 
 def main() -> None:
@@ -40,8 +37,7 @@ def main() -> None:
     optimizers = args.optimizers.split(",")
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores; "
           f"{args.cases} random cases (seed {args.seed}) x {args.repeats} repeats")  # fmt: skip
-    rng = np.random.default_rng(args.seed)
-    cases = LOW + (HIGH - LOW) * rng.uniform(size=(args.cases, 8))
+    cases = random_faults(args.cases, args.seed)
     measured = [emaphm.simulate(k, noise=True, seed=j) for j, k in enumerate(cases)]
 
     rows = []

@@ -10,14 +10,10 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 import emaphm
+from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.monitor import MonitorEma
-
-LOW = np.array([0, 0, 0, 0, 0, 0, 0, 0.3])
-HIGH = np.array([0.6, 0.6, 0.5, 0.5, 0.5, 0.3, 1.0, 0.7])
 
 
 def main() -> None:
@@ -25,7 +21,7 @@ def main() -> None:
     parser.add_argument("--cases", type=int, default=10)
     parser.add_argument("--seed", type=int, default=7)
     args = parser.parse_args()
-    cases = LOW + (HIGH - LOW) * np.random.default_rng(args.seed).uniform(size=(args.cases, 8))
+    cases = random_faults(args.cases, args.seed)
     lf = MonitorEma()
     for j, k in enumerate(cases):
         hf = emaphm.simulate(k, noise=False)

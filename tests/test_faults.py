@@ -54,3 +54,14 @@ def test_parse_cli_form():
     np.testing.assert_array_equal(parse_faults("0, 0.5,0,0,0,0,0,1"), [0, 0.5, 0, 0, 0, 0, 0, 1])
     with pytest.raises(InputError, match="value 2"):
         parse_faults("0,x,0,0,0,0,0,0")
+
+
+def test_random_cases_follow_the_design_ranges_and_the_seed():
+    from emaphm.faults import RANDOM_CASE_RANGES, random_faults
+
+    K = random_faults(500, seed=3)
+    low, high = np.array(RANDOM_CASE_RANGES).T
+    assert np.all(K >= low) and np.all(K <= high)
+    assert np.all(K.max(axis=0) > high - 0.05 * (high - low))  # the ranges are used, not a corner
+    np.testing.assert_array_equal(K, random_faults(500, seed=3))
+    assert not np.array_equal(K, random_faults(500, seed=4))

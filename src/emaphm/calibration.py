@@ -16,10 +16,10 @@ import json
 import math
 import os
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from ._data import read_package_json
 from .errors import InputError
 
 __all__ = ["COEFFICIENT_BOUNDS", "Calibration", "Coefficients", "default_calibration", "load_calibration"]
@@ -168,11 +168,5 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
 @functools.lru_cache(maxsize=1)
 def default_calibration() -> Calibration:
     """The calibration shipped with the package (``emaphm/data/calibration.json``), read once."""
-    ref = resources.files("emaphm") / "data" / "calibration.json"
-    try:
-        data = json.loads(ref.read_text())
-    except FileNotFoundError:
-        raise InputError("the packaged calibration file emaphm/data/calibration.json is missing") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"the packaged calibration file is corrupt ({exc})") from None
+    data = read_package_json("calibration.json")
     return _parse(data, "emaphm/data/calibration.json")

@@ -31,6 +31,7 @@ __all__ = [
     "FAULT_NAMES",
     "HEALTHY",
     "N_MIN",
+    "RANDOM_CASE_RANGES",
     "TABLE1_REFERENCE",
     "FaultedParameters",
     "apply_faults",
@@ -38,6 +39,7 @@ __all__ = [
     "as_fault_vector",
     "fault_parameter_columns",
     "parse_faults",
+    "random_faults",
 ]
 
 FAULT_NAMES: tuple[str, ...] = (
@@ -166,6 +168,18 @@ def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
         F_S=col["F_S"], F_D=col["F_D"], B=col["B"], N=(col["N_A"], col["N_B"], col["N_C"]),
         zeta=col["zeta"], phi_e=col["phi_e"], K_P=col["K_P"],
     )  # fmt: skip
+
+
+RANDOM_CASE_RANGES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.6), (0.0, 0.6), (0.0, 0.5), (0.0, 0.5), (0.0, 0.5), (0.0, 0.3), (0.0, 1.0), (0.3, 0.7),
+)  # fmt: skip
+"""DESIGN §7 ranges of the random benchmark cases, (low, high) per fault k1..k8."""
+
+
+def random_faults(n: int, seed: int) -> NDArray[np.float64]:
+    """n random fault vectors, uniform in `RANDOM_CASE_RANGES`, from `seed` (shape (n, 8))."""
+    low, high = np.array(RANDOM_CASE_RANGES).T
+    return low + (high - low) * np.random.default_rng(seed).uniform(size=(n, len(FAULT_NAMES)))
 
 
 def describe(k: Sequence[float] | NDArray[np.float64]) -> str:

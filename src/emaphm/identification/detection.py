@@ -11,13 +11,12 @@ as ``emaphm/data/detection.json``.
 from __future__ import annotations
 
 import functools
-import json
-from importlib import resources
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._data import read_package_json
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY, as_fault_vector
 
@@ -29,13 +28,7 @@ DETECTABLE = tuple(n for n in FAULT_NAMES if n != "eccentricity_phase")
 @functools.lru_cache(maxsize=1)
 def load_thresholds() -> dict[str, Any]:
     """The shipped thresholds file: {"thresholds": {name: deviation}, ...record}."""
-    ref = resources.files("emaphm") / "data" / "detection.json"
-    try:
-        data = json.loads(ref.read_text())
-    except FileNotFoundError:
-        raise InputError("the packaged detection thresholds emaphm/data/detection.json are missing") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"the packaged detection thresholds are corrupt ({exc})") from None
+    data = read_package_json("detection.json")
     thresholds = data.get("thresholds")
     if not isinstance(thresholds, dict) or set(thresholds) != set(DETECTABLE):
         raise InputError(f"detection thresholds must name exactly {', '.join(DETECTABLE)}")

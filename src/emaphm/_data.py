@@ -1,0 +1,20 @@
+"""The data files shipped inside the package (``emaphm/data``)."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+from typing import Any
+
+from .errors import InputError
+
+
+def read_package_json(name: str) -> Any:
+    """Parse ``emaphm/data/<name>``; a missing or corrupt file raises `InputError` naming it."""
+    where = f"emaphm/data/{name}"
+    try:
+        return json.loads((resources.files("emaphm") / "data" / name).read_text())
+    except FileNotFoundError:
+        raise InputError(f"the packaged file {where} is missing") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"the packaged file {where} is corrupt ({exc})") from None
