@@ -15,6 +15,7 @@ import typer
 from rich.console import Console
 
 from . import __version__
+from ._threads import numba_threads
 from .commands import COMMANDS, make_command
 from .errors import InputError
 from .faults import HEALTHY, describe, parse_faults
@@ -111,13 +112,12 @@ def identify(
     import json
 
     from .identification.identify import identify as run_identify
-    from .identification.optimizers import OPTIMIZERS
+    from .identification.optimizers import check_optimizer
     from .io import atomic_path, check_trace_path
 
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of --true-faults or --reference")
-    if optimizer not in OPTIMIZERS:
-        raise InputError(f"unknown optimizer {optimizer!r}; choose one of {', '.join(OPTIMIZERS)}")
+    check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
     if reference is not None:
         check_trace_path(reference, for_writing=False)
@@ -149,7 +149,7 @@ def _print_identification(data: dict[str, Any]) -> None:
     if data["truth"] is not None:
         table.add_row("true", *(f"{v:.4g}" for v in data["truth"]))
     table.add_row("identified", *(f"{v:.4g}" for v in data["estimate"]))
-    out = Console(highlight=False, width=None if sys.stdout.isatty() else 120)
+    out = _stdout_console()
     out.print(table)
     if data["percent_error"] is not None:
         out.print(f"%err {data['percent_error']:.2f}")
@@ -176,8 +176,7 @@ def calibrate(
         raise InputError(f"{output}: the calibration file must end in .json")
     if not output.parent.is_dir():
         raise InputError(f"{output}: folder {output.parent} does not exist")
-    _set_workers(workers)
-    with _progress() as update:
+    with numba_threads(workers, name="--workers"), _progress() as update:
         cal = run_calibration(seed=seed, pop_size=pop_size, generations=generations, progress=update)
     cal.save(output)
     for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
@@ -188,14 +187,9 @@ def calibrate(
     err.print(f"wrote {output} (seed {seed}, {cal.record['settings']['wall_time_s']:.0f} s)")
 
 
-def _set_workers(workers: int) -> None:
-    """Threads for numba's parallel kernels: 0 means all cores."""
-    import numba
-
-    available = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
-    if workers < 0 or workers > available:
-        raise InputError(f"--workers must be 0..{available}, got {workers}")
-    numba.set_num_threads(workers or available)
+def _stdout_console() -> Console:
+    """Console for results on stdout; 120 columns when not a terminal, so logs get whole tables."""
+    return Console(highlight=False, width=None if sys.stdout.isatty() else 120)
 
 
 @contextmanager
@@ -226,12 +220,8 @@ def demo(
 ) -> None:
     """The main job: the paper's Table 1 experiment (HF twin with noise, five identifications)."""
     from .demo import run_demo
-    from .identification.optimizers import OPTIMIZERS
 
-    if optimizer not in OPTIMIZERS:
-        raise InputError(f"unknown optimizer {optimizer!r}; choose one of {', '.join(OPTIMIZERS)}")
-    console = Console(highlight=False, width=None if sys.stdout.isatty() else 120)  # logs: no squeezed table
-    run_demo(output_dir, seed=seed, optimizer=optimizer, runs=runs, console=console, status=_status)
+    run_demo(output_dir, seed=seed, optimizer=optimizer, runs=runs, console=_stdout_console(), status=_status)
 
 
 def _fail(message: str, status: int) -> None:

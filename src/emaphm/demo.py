@@ -25,6 +25,7 @@ from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
 from .identification.identify import identify
 from .identification.metrics import percent_error
+from .identification.optimizers import check_optimizer
 from .models import simulate
 from .monitor import MonitorEma
 from .plots import plot_convergence, plot_fit, plot_response, plot_vectors
@@ -49,6 +50,7 @@ def run_demo(
         raise InputError(f"--output-dir {output_dir} exists and is not a folder")
     if runs < 1:
         raise InputError(f"runs must be >= 1, got {runs}")
+    check_optimizer(optimizer)
 
     def stage(message: str) -> Any:
         return status(message) if status else nullcontext()

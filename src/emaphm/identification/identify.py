@@ -8,10 +8,8 @@ eq. (3) on the comparison pipeline. `identify` is the library mirror of ``emaphm
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._threads import numba_threads
 from .._version import __version__
 from ..commands import Chirp, Command, SampledCommand
 from ..errors import InputError
@@ -31,7 +30,7 @@ from ..results import SimResult
 from .detection import detect
 from .fitness import Fitness
 from .metrics import absolute_errors, percent_error
-from .optimizers import OnGeneration, OptimizerRun, Stagnation, polish, run_optimizer
+from .optimizers import OnGeneration, OptimizerRun, Stagnation, check_optimizer, polish, run_optimizer
 from .signals import Comparison
 
 __all__ = ["MIN_SAMPLES", "FaultIdentifier", "IdentificationResult", "identify", "search_to_faults"]
@@ -177,22 +176,6 @@ def search_to_faults(X: NDArray[np.float64]) -> NDArray[np.float64]:
     return K
 
 
-@contextlib.contextmanager
-def _threads(workers: int | None) -> Iterator[None]:
-    """Use `workers` numba threads inside the block (None or 0: all)."""
-    import numba
-
-    available = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
-    if workers is not None and not 0 <= workers <= available:
-        raise InputError(f"workers must be 0..{available}, got {workers}")
-    previous = numba.get_num_threads()
-    numba.set_num_threads(workers or available)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(previous)
-
-
 def identify(
     true_faults: ArrayLike | None = None,
     reference: str | os.PathLike[str] | SimResult | None = None,
@@ -214,6 +197,7 @@ def identify(
     `thresholds` overrides the shipped detection thresholds ({} reports nothing).
     """
     seed = check_seed(seed)
+    check_optimizer(optimizer)  # before the twin runs
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -237,7 +221,7 @@ def identify(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
         slope_unit=slope_unit, on_generation=on_generation,
     )  # fmt: skip
-    with _threads(workers):
+    with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command)
     run = ident.run_
     settings = {

@@ -28,7 +28,15 @@ from pymoo.optimize import minimize
 
 from ..errors import InputError
 
-__all__ = ["DEFAULT_BUDGETS", "OPTIMIZERS", "OptimizerRun", "Stagnation", "polish", "run_optimizer"]
+__all__ = [
+    "DEFAULT_BUDGETS",
+    "OPTIMIZERS",
+    "OptimizerRun",
+    "Stagnation",
+    "check_optimizer",
+    "polish",
+    "run_optimizer",
+]
 
 Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 OnGeneration = Callable[[int, int, float], None]  # (generation, max generations, best value)
@@ -99,6 +107,13 @@ class _Monitor(Callback):  # type: ignore[misc]
             algorithm.termination.force_termination = True
 
 
+def check_optimizer(name: str) -> str:
+    """`name` if it is one of `OPTIMIZERS`, else `InputError` listing them."""
+    if name not in OPTIMIZERS:
+        raise InputError(f"unknown optimizer {name!r}; choose one of {', '.join(OPTIMIZERS)}")
+    return name
+
+
 def _pymoo_algorithm(name: str, pop_size: int, n_var: int, rng: np.random.Generator) -> Any:
     if name == "ga":
         from pymoo.algorithms.soo.nonconvex.ga import GA
@@ -117,7 +132,7 @@ def _pymoo_algorithm(name: str, pop_size: int, n_var: int, rng: np.random.Genera
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
 
         return CMAES(x0=rng.uniform(0.2, 0.8, n_var), sigma=0.3, popsize=pop_size, restarts=0)
-    raise InputError(f"unknown optimizer {name!r}; choose one of {', '.join(OPTIMIZERS)}")
+    raise AssertionError(f"no pymoo algorithm for {name!r}")  # names are checked before
 
 
 def run_optimizer(
@@ -132,8 +147,7 @@ def run_optimizer(
     on_generation: OnGeneration | None = None,
 ) -> OptimizerRun:
     """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`)."""
-    if name not in OPTIMIZERS:
-        raise InputError(f"unknown optimizer {name!r}; choose one of {', '.join(OPTIMIZERS)}")
+    check_optimizer(name)
     default_pop, default_gen = DEFAULT_BUDGETS[name]
     pop_size = default_pop if pop_size is None else pop_size
     generations = default_gen if generations is None else generations
