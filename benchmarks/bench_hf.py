@@ -5,7 +5,10 @@ Target ≤ 0.15 s, goal ≤ 0.05 s. Run:
     python benchmarks/bench_hf.py [--repeats 5]
 
 The first call loads (or compiles) the numba kernels and is reported apart; the figure is the
-median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs).
+median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs), and
+the same median as nanoseconds per integration step (wall time of the whole `simulate` call over
+the number of Δt steps, sub-steps included). The last column is the process CPU time per
+simulated second (median): on a shared, busy machine it moves less than the wall time.
 """
 
 from __future__ import annotations
@@ -42,18 +45,26 @@ def main() -> None:
         f"{os.cpu_count()} cores, NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}"
     )
     print(f"first call (import of kernels: compile or cache load): {first:.2f} s")
-    print(f"{'case':<22} {'sub-steps':>9} {'sim s':>6} {'wall s/sim s (median)':>22} {'min':>7} {'max':>7}")
+    dt = emaphm.EmaParams().integration.dt
+    print(
+        f"{'case':<22} {'sub-steps':>9} {'sim s':>6} {'wall s/sim s (median)':>22} {'min':>7} {'max':>7}"
+        f" {'ns/step (median)':>17} {'cpu s/sim s':>12}"
+    )
     for name, k in CASES.items():
         walls = []
+        cpus = []
         for seed in range(args.repeats):
             t0 = time.perf_counter()
+            c0 = time.process_time()
             r = emaphm.simulate(k, seed=seed)
+            cpus.append(time.process_time() - c0)
             walls.append(time.perf_counter() - t0)
         sim_s = float(r.t[-1])
         per = [w / sim_s for w in walls]
         print(
             f"{name:<22} {r.metadata['electrical_substeps']:>9} {sim_s:>6.2f} "
             f"{statistics.median(per):>22.4f} {min(per):>7.4f} {max(per):>7.4f}"
+            f" {statistics.median(per) * dt * 1e9:>17.1f} {statistics.median(cpus) / sim_s:>12.4f}"
         )
 
 

@@ -63,3 +63,99 @@ def test_hysteresis_keeps_current_within_band():
     max_slope_step = V_dc * 1e-6 / L_s
     assert np.max(np.abs(errs)) <= h / 2 + max_slope_step
     assert np.std(errs) > h / 10  # it does switch: the ripple fills the band
+
+
+# ---- the fast loop of hf_twin against the reference kernels -----------------------------------
+
+
+def test_euler_map_is_one_euler_substep_of_stator_derivatives():
+    # i + D·i + V·s + β equals i + h·di/dt from the neutral formula, and every column of the map
+    # sums to zero (the isolated neutral: Σ_x di_x/dt = 0)
+    from emaphm.kernels.pmsm_abc import euler_map, stator_derivatives
+    from emaphm.kernels.transforms import phase_directions
+
+    sp = stator_pack(V_dc, 0.1, 4, [0.5 * R_s, 0.8 * R_s, R_s], [0.25 * L_s, 0.64 * L_s, L_s],
+                     [0.5 * k_e, 0.8 * k_e, k_e], 0.3, 1.1)  # fmt: skip
+    h = 1e-6 / 3
+    D, V, S, C = euler_map(sp, h)
+    D, V, S, C = np.array(D), np.array(V), np.array(S), np.array(C)
+    for M in (D, V, S[:, None], C[:, None]):
+        assert np.max(np.abs(M.sum(axis=0))) <= 1e-15 * np.max(np.abs(M))
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        i = rng.normal(0.0, 2.0, 3)
+        i -= i.mean()
+        s = rng.choice([-1.0, 1.0], 3)
+        th, om = rng.uniform(-10.0, 10.0), rng.uniform(-80.0, 80.0)
+        u = np.array(phase_directions(np.sin(th), np.cos(th)))
+        ecc = 1.0 - sp.zeta * np.cos(th + sp.phi_e)
+        e = np.array([sp.k_e_a, sp.k_e_b, sp.k_e_c]) * ecc * om * u
+        d = np.array(stator_derivatives(*i, *(s * V_dc / 2), *e, sp))
+        step = D @ i + V @ s + om * ecc * (S * np.sin(th) + C * np.cos(th))
+        np.testing.assert_allclose(step, h * d, rtol=1e-11, atol=1e-13 * np.max(np.abs(h * d)))
+
+
+def reference_hf(theta_cmd, theta_noise, lsb, fs, cp, sp, mp, dt, n_per_sample, n_sub):
+    """simulate_hf written plainly with the reference kernels stator_step and mechanics_step."""
+    from emaphm.kernels.controller import pid_step
+    from emaphm.kernels.hf_twin import N_OUT
+    from emaphm.kernels.mechanics import mechanics_step
+    from emaphm.kernels.sensors import quantise
+
+    n = len(theta_cmd)
+    out = np.zeros((n, N_OUT))
+    th_m = om = th_u = integral = om_f = 0.0
+    i_s = (0.0, 0.0, 0.0, 1.0, 1.0, 1.0)  # currents and comparator states
+    acc = np.zeros(5)  # i_a, i_b, i_c, i_q, T_m
+    for k in range(n):
+        th_meas = quantise(th_u + theta_noise[k], lsb, fs)
+        i_q_ref, integral, om_f = pid_step(theta_cmd[k], th_meas, om, integral, om_f, cp)
+        out[k] = (th_u, th_meas, th_m, om, sp.p * th_m, *(acc[:3] / n_per_sample),
+                  acc[3] / n_per_sample, i_q_ref, acc[4] / n_per_sample)  # fmt: skip
+        acc[:] = 0.0
+        for _ in range(n_per_sample if k < n - 1 else 0):
+            *i_s, T_m, i_q = stator_step(*i_s, sp.p * th_m, om, i_q_ref, dt, n_sub, sp)
+            th_m, om, th_u = mechanics_step(th_m, om, th_u, T_m, dt, mp)
+            acc += (*i_s[:3], i_q, T_m)
+    return out
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        # healthy (n_sub = 1): friction break-away from rest, saturated current demand, load
+        dict(N=(1.0, 1.0, 1.0), zeta=0.0, n_sub=1, cmd="step", theta_max=0.5, t_end=4e-3),
+        # unequal phases with eccentricity, sub-stepped, a fast sine: speed reversals (case 4)
+        dict(N=(1.0, 0.55, 0.8), zeta=0.3, n_sub=3, cmd="sine", theta_max=0.5, t_end=4e-3),
+        # the end-stop is reached after ≈ 2 ms and then pressed into
+        dict(N=(0.7, 1.0, 1.0), zeta=0.1, n_sub=2, cmd="step", theta_max=2e-4, t_end=4e-3),
+    ],
+    ids=["healthy", "unequal-ecc", "end-stop"],
+)
+def test_fast_loop_matches_stator_step_and_mechanics_step(case):
+    # hf_twin.simulate_hf reorders the same equations for speed (rotation of sin/cos θ_e, the
+    # linear Euler map, i_c = −(i_a + i_b)); thousands of steps with hundreds of comparator
+    # switches must agree with the reference kernels to rounding
+    from emaphm.kernels.controller import ControllerPack
+    from emaphm.kernels.hf_twin import N_OUT, simulate_hf
+    from emaphm.kernels.mechanics import MechanicsPack
+
+    N = case["N"]
+    sp = stator_pack(V_dc, 0.1, 4, [n * R_s for n in N], [n**2 * L_s for n in N],
+                     [n * k_e for n in N], case["zeta"], 2.0)  # fmt: skip
+    cp = ControllerPack(60.0, 200.0, 3.5, 1e-3, 10.0, 1e-4, 200.0)
+    mp = MechanicsPack(5e-5 + 0.05 / 200.0**2, 1e-5, 0.02, 0.014, 2e-4, 200.0, 0.9, case["theta_max"], 5.0)
+    t = np.arange(round(case["t_end"] * 1e4) + 1) * 1e-4
+    cmd = np.full_like(t, 0.3) if case["cmd"] == "step" else 0.2 * np.sin(2 * np.pi * 250.0 * t)
+    noise = np.random.default_rng(1).normal(0.0, 1e-5, len(t))
+    args = (cmd, noise, 1.8e-5, 0.6, cp, sp, mp, 1e-6, 100, case["n_sub"])
+    fast = np.empty((len(t), N_OUT))
+    simulate_hf(*args, fast)
+    ref = reference_hf(*args)
+    scale = np.max(np.abs(ref), axis=0)
+    assert np.all(np.abs(fast - ref) <= 1e-9 * scale + 1e-300)
+    assert np.max(np.abs(ref[:, 3])) > 10.0  # the motor did move (rad/s)
+    if case["cmd"] == "sine":
+        assert np.any(ref[1:, 3] > 1.0) and np.any(ref[1:, 3] < -1.0)  # speed reversals
+    if case["theta_max"] < 0.1:
+        assert np.sum(ref[:, 0] == case["theta_max"]) > 5  # rows at the stop

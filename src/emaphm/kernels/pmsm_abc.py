@@ -13,6 +13,9 @@ Per phase x ∈ {a, b, c}, with γ_a = 0, γ_b = 2π/3, γ_c = −2π/3 and u_x 
 
 The neutral formula is the general one: it follows from Σ_x di_x/dt = 0 and keeps
 i_a + i_b + i_c = 0 with unequal phases (the mean of v_x0 holds only for balanced phases).
+With the neutral eliminated the stator is linear in the currents, di/dt = M·(v_0 − R·i − e) with
+M_xy = (δ_xy − L_n/L_y)/L_x and L_n = 1/Σ_y(1/L_y); `euler_map` gives one explicit-Euler sub-step
+of it as the linear map the fast loop (`hf_twin.simulate_hf`) uses.
 
 Because L_x ∝ N_x², a shorted coil's current moves much faster; the electrical part is
 therefore sub-stepped (n_sub sub-steps per mechanical step, chosen by the API so that no current
@@ -26,7 +29,7 @@ import math
 from typing import NamedTuple
 
 from ._jit import jit
-from .transforms import clarke, phase_directions
+from .transforms import HALF_SQRT3, clarke, phase_directions
 
 
 class StatorPack(NamedTuple):
@@ -128,3 +131,44 @@ def stator_step(i_a, i_b, i_c, s_a, s_b, s_c, theta_e, omega_m, i_q_ref, dt, n_s
     i_alpha, i_beta = clarke(i_a, i_b, i_c)
     i_q = -i_alpha * sin_e + i_beta * cos_e  # Park, DESIGN §3.9
     return i_a, i_b, i_c, s_a, s_b, s_c, T_sum / n_sub, i_q
+
+
+@jit
+def euler_map(sp, h_sub):  # type: ignore[no-untyped-def]
+    """One explicit-Euler sub-step of `stator_derivatives` as a linear map (DESIGN §3.4–§3.7).
+
+    With the comparator states s_x held over the sub-step, i ← i + h·M·(v_0 − R·i − e) is
+
+        i ← i + Δ,   Δ = D·i + V·s + β,   D = −h·M·R,   V = h·(V_dc/2)·M,   β = −h·M·e,
+        β_x = ω_m·ecc·(S_x·sin θ_e + C_x·cos θ_e),   ecc = 1 − ζ·cos(θ_e + φ_e),
+
+    because e_y = k_e,y·ecc·ω_m·u_y and u_y = a_y·sin θ_e + b_y·cos θ_e (a = (−1, ½, ½),
+    b = (0, √3/2, −√3/2), `transforms.phase_directions`): S_x = −h·Σ_y M_xy·k_e,y·a_y and
+    C_x = −h·Σ_y M_xy·k_e,y·b_y. Every column of M sums to zero (Σ_x di_x/dt = 0), so
+    Δ_c = −(Δ_a + Δ_b). Same equations as `stator_step`, grouped so that the step's one dependency
+    chain is short; the results differ from it by rounding only.
+
+    Returns (D, V, S, C): D and V as three rows (x = a, b, c) of three, S and C as triples.
+    """
+    inv_L = (sp.inv_L_a, sp.inv_L_b, sp.inv_L_c)
+    R = (sp.R_a, sp.R_b, sp.R_c)
+    ke = (sp.k_e_a, sp.k_e_b, sp.k_e_c)
+    a = (-1.0, 0.5, 0.5)
+    b = (0.0, HALF_SQRT3, -HALF_SQRT3)
+    half_V = 0.5 * sp.V_dc
+
+    def m(x, y):  # type: ignore[no-untyped-def]
+        # DESIGN §3.4: M_xy = (δ_xy − L_n/L_y)/L_x
+        return ((1.0 if x == y else 0.0) - sp.L_n * inv_L[y]) * inv_L[x]
+
+    def row(x):  # type: ignore[no-untyped-def]
+        D = (-h_sub * m(x, 0) * R[0], -h_sub * m(x, 1) * R[1], -h_sub * m(x, 2) * R[2])
+        V = (h_sub * half_V * m(x, 0), h_sub * half_V * m(x, 1), h_sub * half_V * m(x, 2))
+        S = -h_sub * (m(x, 0) * ke[0] * a[0] + m(x, 1) * ke[1] * a[1] + m(x, 2) * ke[2] * a[2])
+        C = -h_sub * (m(x, 0) * ke[0] * b[0] + m(x, 1) * ke[1] * b[1] + m(x, 2) * ke[2] * b[2])
+        return D, V, S, C
+
+    D_a, V_a, S_a, C_a = row(0)
+    D_b, V_b, S_b, C_b = row(1)
+    D_c, V_c, S_c, C_c = row(2)
+    return (D_a, D_b, D_c), (V_a, V_b, V_c), (S_a, S_b, S_c), (C_a, C_b, C_c)
