@@ -19,7 +19,7 @@ import numpy as np
 
 import emaphm
 from emaphm.identification import Comparison
-from emaphm.monitor import MonitorEma
+from emaphm.models import MonitorEma
 
 CASES = {
     "healthy": emaphm.HEALTHY,

@@ -20,7 +20,7 @@ import numpy as np
 
 import emaphm
 from emaphm.kernels.monitor import N_AUX, simulate_lf, simulate_lf_many
-from emaphm.monitor import MonitorEma
+from emaphm.models import MonitorEma
 
 
 def main() -> None:

@@ -13,7 +13,7 @@ import argparse
 import emaphm
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.monitor import MonitorEma
+from emaphm.models import MonitorEma
 
 
 def main() -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 import emaphm
 from emaphm.calibration import Calibration, Coefficients
 from emaphm.identification.calibrate import CHECK_SCENARIOS, FIT_SCENARIOS
-from emaphm.monitor import MonitorEma
+from emaphm.models import MonitorEma
 from emaphm.plots import plot_calibration, plot_response
 
 FIGURES = Path(__file__).parent / "figures"

@@ -6,42 +6,35 @@ import numpy as np
 import pytest
 
 import emaphm
-from emaphm import InputError
+from emaphm import InputError, MonitorEma
 from emaphm.calibration import Calibration, Coefficients, default_calibration, load_calibration
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CHECK_SCENARIOS, FIT_SCENARIOS, calibrate
-from emaphm.monitor import MonitorEma
-from tests.conftest import faults
+from tests.helpers import faults
 
-# held-out scenarios (not in FIT_SCENARIOS) with the NRMSE bound the calibration promises;
-# docs/theory/monitor-model.md gives the measured values (1.4..3.9 %, Table 1 5.6 %)
-HELD_OUT = {s.name: s for s in CHECK_SCENARIOS}
-BOUNDS = {
-    "friction k1=0.5": 0.05,
-    "backlash k2=0.4": 0.05,
-    "gain k8=0.25": 0.05,
-    "short B k4=0.45 + friction k1=0.2": 0.05,
-    "random mix": 0.05,
-    "paper Table 1 reference": 0.07,  # misses the 5 % target: see the docs
-}
+# DESIGN §4 target for the calibrated LF model against the HF twin (filtered i_q, noise off), on
+# scenarios the calibration never saw. Measured live: 1.31-2.97 % (Table 1 vector the highest;
+# docs/theory/monitor-model.md §4)
+NRMSE_TARGET = 0.05
 
 
 def test_held_out_scenarios_are_not_fitted():
     fitted = {s.faults for s in FIT_SCENARIOS}
-    assert not any(s.faults in fitted for s in CHECK_SCENARIOS)
+    assert len(CHECK_SCENARIOS) >= 8 and not any(s.faults in fitted for s in CHECK_SCENARIOS)
 
 
-@pytest.mark.parametrize("name", list(BOUNDS))
-def test_calibrated_lf_matches_hf_on_held_out_scenarios(name):
-    k = HELD_OUT[name].faults
-    hf = emaphm.simulate(k, noise=False)
-    lf = emaphm.simulate(k, model="lf", noise=False)
+@pytest.mark.parametrize("scenario", CHECK_SCENARIOS, ids=lambda s: s.name)
+def test_calibrated_lf_matches_hf_on_held_out_scenarios(scenario):
+    hf = emaphm.simulate(scenario.faults, noise=False)
+    lf = emaphm.simulate(scenario.faults, model="lf", noise=False)
+    np.testing.assert_array_equal(lf.t, hf.t)
     ref = Comparison.from_signal(hf.t, hf.i_q, 1e4)
-    assert ref.nrmse(lf.i_q) < BOUNDS[name]
+    assert ref.nrmse(lf.i_q) < NRMSE_TARGET
 
 
 def test_uncalibrated_lf_is_worse_on_shorts():
-    # the calibration is what makes the short-circuit shape function fit (k_FS: 1 -> ~80)
+    # the calibration is what makes the short-circuit shape function fit (k_FS: 1 -> ~80);
+    # measured NRMSE 2.5 % calibrated against 4.7 % with the first-guess coefficients
     k = faults(k3=0.3)
     hf = emaphm.simulate(k, noise=False)
     ref = Comparison.from_signal(hf.t, hf.i_q, 1e4)
@@ -78,11 +71,13 @@ def test_fault_matrix_validation():
 
 
 def test_packaged_calibration_is_complete():
+    # schema only: the LF-vs-HF figures are checked live above, not read from this file
     cal = default_calibration()
     for key in ("seed", "package_version", "fit_scenarios", "check_scenarios", "settings"):
         assert key in cal.record
-    assert len(cal.record["fit_scenarios"]) == len(FIT_SCENARIOS)
-    assert all(0 < s["nrmse"] < 0.1 for s in cal.record["check_scenarios"])
+    assert [s["name"] for s in cal.record["fit_scenarios"]] == [s.name for s in FIT_SCENARIOS]
+    assert [s["name"] for s in cal.record["check_scenarios"]] == [s.name for s in CHECK_SCENARIOS]
+    assert all(isinstance(s["nrmse"], float) for s in cal.record["check_scenarios"])
 
 
 def test_calibration_round_trip(tmp_path):

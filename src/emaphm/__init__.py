@@ -11,33 +11,46 @@ The public API:
 - `Chirp`, `Step`, `Ramp`, `Sine` are position commands;
 - `read_trace` / `write_trace` store traces as HDF5 or CSV;
 - `identify` / `FaultIdentifier` find the fault vector from a measured current (DESIGN §5) and
-  `percent_error` scores it (paper eq. 4, the reading that reproduces Table 1).
+  `percent_error` scores it (paper eq. 4, the reading that reproduces Table 1);
+- `calibrate` fits the monitor model to the twin, `load_calibration` reads such a file.
+
+The names are imported on first use (PEP 562), so ``import emaphm`` and ``emaphm --version``
+stay fast: numba kernels, scipy and pymoo load only when a name that needs them is used.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from ._version import __version__
-from .commands import Chirp, Ramp, Sine, Step, make_command
-from .errors import InputError
-from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
-from .identification.identify import FaultIdentifier, IdentificationResult, identify
-from .identification.metrics import percent_error
-from .io import read_trace, write_trace
-from .models import HighFidelityEma, simulate
-from .monitor import MonitorEma
-from .params import (
-    ControllerParams,
-    EmaParams,
-    IntegrationParams,
-    InverterParams,
-    MotorParams,
-    SensorParams,
-    TransmissionParams,
-)
-from .results import SimResult
+from .errors import InputError, SimulationError
+
+# public name -> module that defines it
+_LAZY = {
+    "Chirp": "commands", "Ramp": "commands", "Sine": "commands", "Step": "commands",
+    "make_command": "commands",
+    "FAULT_NAMES": "faults", "HEALTHY": "faults", "TABLE1_REFERENCE": "faults",
+    "apply_faults": "faults", "as_fault_vector": "faults",
+    "FaultIdentifier": "identification.identify", "IdentificationResult": "identification.identify",
+    "identify": "identification.identify",
+    "percent_error": "identification.metrics", "absolute_errors": "identification.metrics",
+    "detect": "identification.detection",
+    "calibrate": "identification.calibrate",
+    "Calibration": "calibration", "load_calibration": "calibration",
+    "read_trace": "io", "write_trace": "io",
+    "HighFidelityEma": "models", "MonitorEma": "models", "simulate": "models",
+    "ControllerParams": "params", "EmaParams": "params", "IntegrationParams": "params",
+    "InverterParams": "params", "MotorParams": "params", "SensorParams": "params",
+    "TransmissionParams": "params",
+    "SimResult": "results",
+}  # fmt: skip
 
 __all__ = [
     "FAULT_NAMES",
     "HEALTHY",
     "TABLE1_REFERENCE",
+    "Calibration",
     "Chirp",
     "ControllerParams",
     "EmaParams",
@@ -52,16 +65,56 @@ __all__ = [
     "Ramp",
     "SensorParams",
     "SimResult",
+    "SimulationError",
     "Sine",
     "Step",
     "TransmissionParams",
     "__version__",
+    "absolute_errors",
     "apply_faults",
     "as_fault_vector",
+    "calibrate",
+    "detect",
     "identify",
+    "load_calibration",
     "make_command",
     "percent_error",
     "read_trace",
     "simulate",
     "write_trace",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'emaphm' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # later lookups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
+
+if TYPE_CHECKING:  # what type checkers and IDEs see
+    from .calibration import Calibration, load_calibration
+    from .commands import Chirp, Ramp, Sine, Step, make_command
+    from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
+    from .identification.calibrate import calibrate
+    from .identification.detection import detect
+    from .identification.identify import FaultIdentifier, IdentificationResult, identify
+    from .identification.metrics import absolute_errors, percent_error
+    from .io import read_trace, write_trace
+    from .models import HighFidelityEma, MonitorEma, simulate
+    from .params import (
+        ControllerParams,
+        EmaParams,
+        IntegrationParams,
+        InverterParams,
+        MotorParams,
+        SensorParams,
+        TransmissionParams,
+    )
+    from .results import SimResult

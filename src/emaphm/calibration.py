@@ -6,23 +6,44 @@ gains k_t,eq and k_e,eq, plus the inertia J_eq the LF model sees and the time co
 simplified current loop. `emaphm calibrate` fits them with a GA against the HF twin
 (`emaphm.identification.calibrate`); the result ships as ``emaphm/data/calibration.json`` and is
 what the LF model loads by default.
+
+A calibration belongs to one actuator: it records the parameters it was fitted for
+(``settings.params``) and their digest (``params_hash``, `params_hash`). `MonitorEma` refuses
+a calibration made for other parameters (`Calibration.check_params`): the LF model would
+otherwise mix the user's drive train with, e.g., the inertia J_eq fitted for another one.
+The measurement-noise levels (``sensors.sigma_*``) are not part of the actuator: they are left
+out of the comparison and of the digest.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import hashlib
 import json
 import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ._data import read_package_json
 from .errors import InputError
 
-__all__ = ["COEFFICIENT_BOUNDS", "Calibration", "Coefficients", "default_calibration", "load_calibration"]
+if TYPE_CHECKING:
+    from .params import EmaParams
+
+__all__ = [
+    "COEFFICIENT_BOUNDS",
+    "Calibration",
+    "Coefficients",
+    "actuator_params",
+    "default_calibration",
+    "load_calibration",
+    "params_hash",
+]
+
+NOT_ACTUATOR = ("sigma_current", "sigma_position")  # noise levels: not part of what is calibrated
 
 FORMAT = "emaphm-lf-calibration"
 FORMAT_VERSION = 2
@@ -99,6 +120,20 @@ class Coefficients:
         return cls(**{n: float(v) for n, v in zip(COEFFICIENT_BOUNDS, x, strict=True)})
 
 
+def actuator_params(params: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """The parameter groups (`EmaParams.to_dict` form) without the measurement-noise levels."""
+    return {
+        group: {k: v for k, v in values.items() if k not in NOT_ACTUATOR} for group, values in params.items()
+    }
+
+
+def params_hash(params: EmaParams | dict[str, dict[str, Any]]) -> str:
+    """A 16-hex digest of the actuator parameters (noise levels excluded), stable across runs."""
+    data = params if isinstance(params, dict) else params.to_dict()
+    text = json.dumps(actuator_params(data), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 @dataclass(frozen=True)
 class Calibration:
     """A calibration: coefficients, the LF step, and the record of how they were obtained."""
@@ -107,8 +142,42 @@ class Calibration:
     n_lf: int = 1  # LF steps per sample period (1: the LF model steps at T_s = 100 µs)
     record: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def params(self) -> dict[str, dict[str, Any]] | None:
+        """The parameters (`EmaParams.to_dict` form) this calibration was fitted for, if recorded."""
+        params = self.record.get("settings", {}).get("params")
+        return params if isinstance(params, dict) else None
+
+    @property
+    def params_hash(self) -> str | None:
+        """Digest of the recorded parameters (`params_hash`), None for an unbound calibration."""
+        return None if self.params is None else params_hash(self.params)
+
+    def check_params(self, params: EmaParams, *, where: str = "the calibration") -> None:
+        """`InputError` unless `params` are the actuator this calibration was fitted for.
+
+        A calibration that records no parameters (built in code) is accepted for any.
+        """
+        made_for = self.params
+        if made_for is None:
+            return
+        mine, theirs = actuator_params(params.to_dict()), actuator_params(made_for)
+        differ = [
+            f"{group}.{key} = {value!r} (calibrated for {theirs.get(group, {}).get(key)!r})"
+            for group, values in mine.items()
+            for key, value in values.items()
+            if theirs.get(group, {}).get(key) != value
+        ]
+        if differ:
+            more = f" and {len(differ) - 2} more" if len(differ) > 2 else ""
+            raise InputError(
+                f"{where} was made for other actuator parameters (hash {params_hash(made_for)}, these are "
+                f"{params_hash(params)}): {'; '.join(differ[:2])}{more}; "
+                "calibrate the monitor for them (emaphm.calibrate(params=...)) and pass that calibration"
+            )
+
     def to_json(self) -> dict[str, Any]:
-        return {
+        data = {
             "format": FORMAT,
             "format_version": FORMAT_VERSION,
             "coefficients": dataclasses.asdict(self.coefficients),
@@ -116,6 +185,9 @@ class Calibration:
             "n_lf": self.n_lf,
             **self.record,
         }
+        if self.params_hash is not None:
+            data["params_hash"] = self.params_hash
+        return data
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the calibration file atomically (JSON)."""
@@ -145,12 +217,16 @@ def _parse(data: Any, where: str) -> Calibration:
     record = {
         k: v
         for k, v in data.items()
-        if k not in ("format", "format_version", "coefficients", "derived", "n_lf")
+        if k not in ("format", "format_version", "coefficients", "derived", "n_lf", "params_hash")
     }
     try:
-        return Calibration(Coefficients(**coeffs), n_lf, record)
+        cal = Calibration(Coefficients(**coeffs), n_lf, record)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
+    stored = data.get("params_hash")
+    if stored is not None and stored != cal.params_hash:
+        raise InputError(f"{where}: params_hash {stored!r} does not match the recorded parameters")
+    return cal
 
 
 def load_calibration(path: str | os.PathLike[str]) -> Calibration:

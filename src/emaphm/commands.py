@@ -82,7 +82,10 @@ class Chirp(_Checked):
         phase = 2.0 * np.pi * (self.f0 * t + (self.f1 - self.f0) * t**2 / (2.0 * self.T))
         f = self.f0 + (self.f1 - self.f0) * t / self.T
         A = np.minimum(self.A_max, self.V_max / (2.0 * np.pi * f))
-        w = np.where(t < self.t_f, 0.5 * (1.0 - np.cos(np.pi * t / max(self.t_f, 1e-300))), 1.0)
+        if self.t_f > 0.0:  # raised-cosine fade-in over t_f
+            w = np.where(t < self.t_f, 0.5 * (1.0 - np.cos(np.pi * np.minimum(t, self.t_f) / self.t_f)), 1.0)
+        else:
+            w = np.ones_like(t)
         return w * A * np.sin(phase)
 
 
@@ -114,7 +117,7 @@ class Ramp(_Checked):
 
 @dataclass(frozen=True)
 class Sine(_Checked):
-    """Sine of `amplitude` [rad] and `frequency` [Hz], starting from rest at zero."""
+    """Sine of `amplitude` [rad] and `frequency` [Hz], starting at zero position (with velocity 2π·f·A)."""
 
     amplitude: float = 0.02
     frequency: float = 2.0

@@ -7,16 +7,23 @@ attribute); the metadata as root attributes, scalars as they are and nested valu
 CSV: one column per signal with a header row of the names; the metadata, with the units, in
 ``FILE.json`` beside it (``out.csv`` → ``out.csv.json``).
 
-Writes are atomic: everything goes to temporary files that replace the targets only once complete,
-so a failure leaves nothing half-written.
+Writes are atomic: everything goes to temporary files (``.NAME.emaphm-PID-XXXX.tmp`` beside the
+target) that replace the targets only once complete, so a failure or Ctrl-C leaves nothing
+half-written. Ctrl-C during a write is held until the write ends, then the temporary file is
+removed and the interruption goes on. Temporaries left by a killed process (``kill -9``) are
+removed by the next write to the same target. Files are created with the permissions the umask
+allows, like any other tool's.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import signal
 import tempfile
-from collections.abc import Iterator
+import threading
+import warnings
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -26,31 +33,150 @@ import numpy as np
 from .errors import InputError
 from .results import REQUIRED_SIGNALS, UNITS, SimResult
 
-__all__ = ["TRACE_SUFFIXES", "atomic_path", "check_trace_path", "read_trace", "write_trace"]
+__all__ = [
+    "TRACE_SUFFIXES",
+    "atomic_path",
+    "check_output_path",
+    "check_trace_path",
+    "read_trace",
+    "side_file",
+    "write_trace",
+]
 
 TRACE_SUFFIXES = (".h5", ".hdf5", ".csv")
 
 
+def side_file(path: Path) -> Path | None:
+    """The JSON side file of a CSV trace (``out.csv`` → ``out.csv.json``), None for other files."""
+    return path.with_name(path.name + ".json") if path.suffix.lower() == ".csv" else None
+
+
+def check_output_path(
+    path: str | os.PathLike[str],
+    *,
+    suffixes: Sequence[str],
+    option: str = "--output",
+    inputs: Sequence[str | os.PathLike[str] | None] = (),
+) -> Path:
+    """Validate an output path before any work: its suffix, a writable existing folder, not a
+    folder itself, and not one of the `inputs` (or a CSV input's side file). `InputError` else.
+    """
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise InputError(
+            f"{option} {p}: unsupported file type {p.suffix or '(none)'!r}; use {' or '.join(suffixes)}"
+        )
+    targets = [p] + ([side] if (side := side_file(p)) is not None else [])
+    for target in targets:
+        if target.is_dir():
+            raise InputError(f"{option} {p}: {target} is a folder")
+    if not p.parent.is_dir():
+        raise InputError(f"{option} {p}: folder {p.parent} does not exist")
+    if not os.access(p.parent, os.W_OK | os.X_OK):
+        raise InputError(f"{option} {p}: folder {p.parent} is not writable")
+    for target in targets:
+        if target.exists() and not os.access(target, os.W_OK):
+            raise InputError(f"{option} {p}: {target} is not writable")
+    for source in inputs:
+        if source is None:
+            continue
+        src = Path(source)
+        protected = [src] + ([side] if (side := side_file(src)) is not None else [])
+        for target in targets:
+            for q in protected:
+                if _same_file(target, q):
+                    raise InputError(f"{option} {p}: would overwrite the input {q}")
+    return p
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if a.exists() and b.exists():
+            return a.samefile(b)
+    except OSError:
+        pass
+    return a.resolve() == b.resolve()
+
+
 def check_trace_path(path: str | os.PathLike[str], *, for_writing: bool = True) -> Path:
-    """Validate a trace path's extension (and, for writing, that its folder exists)."""
+    """Validate a trace path's extension; for writing as `check_output_path`, for reading that
+    it is an existing file."""
     p = Path(path)
     if p.suffix.lower() not in TRACE_SUFFIXES:
         raise InputError(f"{p}: unsupported file type {p.suffix or '(none)'!r}; use .h5 or .csv")
-    if for_writing and not p.parent.is_dir():
-        raise InputError(f"{p}: folder {p.parent} does not exist")
-    if not for_writing and not p.is_file():
+    if for_writing:
+        check_output_path(p, suffixes=TRACE_SUFFIXES, option="output")
+    elif p.is_dir():
+        raise InputError(f"{p}: is a folder, not a trace file")
+    elif not p.is_file():
         raise InputError(f"{p}: no such file")
     return p
 
 
+_TMP_TAG = "emaphm"
+
+
+def _remove_stale_temporaries(target: Path) -> None:
+    """Delete temporaries of `target` left by emaphm processes that no longer run (kill -9)."""
+    for tmp in target.parent.glob(f".{target.name}.{_TMP_TAG}-*.tmp"):
+        try:
+            pid = int(tmp.name[len(f".{target.name}.{_TMP_TAG}-") :].split("-", 1)[0])
+        except ValueError:
+            continue
+        if pid == os.getpid():
+            continue
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            tmp.unlink(missing_ok=True)
+        except OSError:  # alive under another user: not ours to remove
+            continue
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+@contextmanager
+def _sigint_deferred() -> Iterator[list[bool]]:
+    """Hold Ctrl-C (SIGINT) for the block; the yielded flag tells whether one arrived."""
+    caught = [False]
+    if threading.current_thread() is not threading.main_thread():
+        yield caught
+        return
+
+    def hold(signum: int, frame: object) -> None:
+        caught[0] = True
+
+    previous = signal.signal(signal.SIGINT, hold)
+    try:
+        yield caught
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @contextmanager
 def atomic_path(target: Path) -> Iterator[Path]:
-    """Yield a temporary path beside `target`; it replaces `target` only if the block succeeds."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    """Yield a temporary path beside `target`; it replaces `target` only if the block succeeds.
+
+    Ctrl-C inside the block is held until the block ends; the temporary is then removed and
+    `KeyboardInterrupt` raised, so the target is either the old file or the complete new one.
+    """
+    target = Path(target)
+    _remove_stale_temporaries(target)
+    fd, tmp = tempfile.mkstemp(
+        prefix=f".{target.name}.{_TMP_TAG}-{os.getpid()}-", suffix=".tmp", dir=target.parent
+    )
     os.close(fd)
+    os.chmod(tmp, 0o666 & ~_umask())
     try:
-        yield Path(tmp)
-        os.replace(tmp, target)
+        with _sigint_deferred() as interrupted:
+            yield Path(tmp)
+            if interrupted[0]:
+                raise KeyboardInterrupt
+            os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -125,8 +251,14 @@ def read_trace(path: str | os.PathLike[str]) -> SimResult:
 def _read_csv(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     with p.open() as fh:
         header = fh.readline().strip().lstrip("#").strip()
-    names = [h.strip() for h in header.split(",")]
-    data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    if not header:
+        raise InputError(f"{p}: the file is empty")
+    names = [h.strip().strip('"').strip("'") for h in header.split(",")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # numpy's "input contained no data": said below, in one line
+        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    if data.size == 0:
+        raise InputError(f"{p}: the file has a header but no data rows")
     if data.shape[1] != len(names):
         raise InputError(f"{p}: header names {len(names)} columns, rows have {data.shape[1]}")
     side = p.with_name(p.name + ".json")

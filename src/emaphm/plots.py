@@ -1,4 +1,4 @@
-"""Figures (matplotlib, Agg backend): the HF response and the LF calibration, like the paper's Fig. 4."""
+"""Figures (matplotlib, Agg backend): the HF response, the LF calibration (like the paper's Fig. 4), fits, convergence, fault vectors."""
 
 from __future__ import annotations
 

@@ -6,11 +6,16 @@ import pytest
 import emaphm
 from emaphm import InputError
 from emaphm.commands import Chirp
+from emaphm.identification import optimizers
+from emaphm.identification.detection import detect
 from emaphm.identification.identify import FaultIdentifier, identify
-from emaphm.identification.metrics import absolute_errors
+from emaphm.identification.metrics import absolute_errors, percent_error
 from emaphm.identification.optimizers import OPTIMIZERS, Stagnation, run_optimizer
 
-SMALL = {"pop_size": 32, "generations": 20}
+# Budgets. The global search only has to land in the right basin; the CMA-ES polish does the
+# converging. TINY checks plumbing and determinism, not convergence.
+TINY = {"pop_size": 16, "generations": 3, "local_polish": False}
+RECOVERY = {"pop_size": 16, "generations": 5}  # with the polish, shrunk by the `small_polish` fixture
 
 
 @pytest.fixture(scope="module")
@@ -28,24 +33,36 @@ def measured():
     }
 
 
-@pytest.mark.parametrize(("case", "tol"), [("backlash", 0.02), ("friction+shortB", 0.04)])
-def test_recovers_known_faults_on_a_small_budget(measured, case, tol):
-    # tolerance per fault (k7 excluded: with no eccentricity its phase is meaningless); measured
-    # errors at this budget were ≤ 0.003 (backlash) and ≤ 0.015 (friction + short B)
+# Largest |error| per fault (k7 excluded: with no eccentricity its phase is meaningless), measured
+# at this budget (GA 16 x 5, polish 16 x 50) over optimiser seeds 1..12: 0.0044 (backlash) and
+# 0.0186 (friction + short B; about 0.012 at every seed, also at the shipped budget: the LF
+# model's own bias, not search noise). The tolerances are 2.3x and 2.2x those worst cases.
+@pytest.mark.slow
+@pytest.mark.parametrize(("case", "tol"), [("backlash", 0.01), ("friction+shortB", 0.04)])
+def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, tol):
     truth, r = measured[case]
-    ident = FaultIdentifier("ga", seed=1, **SMALL).fit(r.t, r.i_q, Chirp())
+    ident = FaultIdentifier("ga", seed=1, **RECOVERY).fit(r.t, r.i_q, Chirp())
     err = absolute_errors(ident.faults_, truth)
     assert np.all(np.delete(err, 6) < tol), err
-    assert ident.run_.evaluations <= 32 * 21 + 32 * 51
+    pop, gen = small_polish
+    assert ident.run_.evaluations <= 16 * 6 + pop * (gen + 1)
 
 
-def test_same_seed_same_estimate_other_seed_differs(measured):
+def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
+    # determinism needs no convergence: a tiny GA, then a tiny polish (its seed path too)
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
     _, r = measured["friction+shortB"]
-    a = FaultIdentifier("ga", seed=3, **SMALL).fit(r.t, r.i_q).faults_
-    b = FaultIdentifier("ga", seed=3, **SMALL).fit(r.t, r.i_q).faults_
-    c = FaultIdentifier("ga", seed=4, **SMALL).fit(r.t, r.i_q).faults_
-    np.testing.assert_array_equal(a, b)
-    assert not np.array_equal(a, c)
+
+    def run(seed, polish):
+        return FaultIdentifier("ga", seed=seed, **{**TINY, "local_polish": polish}).fit(r.t, r.i_q).faults_
+
+    found = {}
+    for polish in (False, True):
+        a, b, c = run(3, polish), run(3, polish), run(4, polish)
+        np.testing.assert_array_equal(a, b)
+        assert not np.array_equal(a, c)
+        found[polish] = a
+    assert not np.array_equal(found[True], found[False])  # the polish ran and moved the estimate
 
 
 @pytest.mark.parametrize("name", OPTIMIZERS)
@@ -68,14 +85,16 @@ def test_every_optimizer_runs_and_improves(name):
 
 
 def test_identify_records_what_it_did():
-    res = identify([0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, **SMALL, local_polish=False)
+    res = identify([0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, **TINY)
     data = res.to_json()
     for key in ("estimate", "fault_names", "truth", "percent_error", "fitness", "evaluations", "wall_time_s",
                 "seed", "optimizer", "version", "detected"):  # fmt: skip
         assert key in data
     assert data["seed"] == 2 and data["optimizer"] == "ga" and data["truth"][0] == 0.3
     assert data["settings"]["noise_seed"] != data["settings"]["optimizer_seed"]
-    assert "friction" in data["detected"]
+    assert data["settings"]["generations_run"] == 3 and data["evaluations"] == 16 * 3
+    assert data["percent_error"] == percent_error(res.estimate, [0.3, 0, 0, 0, 0, 0, 0, 0.5])
+    assert data["detected"] == detect(res.estimate)  # the shipped thresholds, applied to the estimate
 
 
 def test_identify_bad_input(tmp_path):

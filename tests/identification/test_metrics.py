@@ -40,3 +40,19 @@ def test_metric_basics():
         percent_error(k, k, form="other")
     with pytest.raises(InputError, match="estimate"):
         percent_error([0.1] * 7, k)
+
+
+@pytest.mark.parametrize("form", ["table1", "printed"])
+def test_eccentricity_phase_error_is_taken_on_the_circle(form):
+    # ζ = 0.3: k7 = 0.99 against 0.01 is a 0.02 turn error (0.3·0.02 = 0.6 %err in the Table 1
+    # form), not 0.98 (29.4 %err); the same phase error across the wrap scores as away from it
+    truth = [0, 0, 0, 0, 0, 0.3, 0.01, 0.5]
+    across = percent_error([0, 0, 0, 0, 0, 0.3, 0.99, 0.5], truth, form=form)
+    inside = percent_error([0, 0, 0, 0, 0, 0.3, 0.03, 0.5], truth, form=form)
+    assert across == pytest.approx(inside, rel=1e-9)
+    if form == "table1":
+        assert across == pytest.approx(0.6, rel=1e-9)
+    # half a turn is the largest phase error
+    half = percent_error([0, 0, 0, 0, 0, 0.3, 0.51, 0.5], truth, form=form)
+    assert half == pytest.approx(percent_error([0, 0, 0, 0, 0, 0.3, 0.51 - 1e-12, 0.5], truth, form=form))
+    assert half >= across

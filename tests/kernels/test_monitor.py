@@ -3,8 +3,18 @@
 import numpy as np
 import pytest
 
-from emaphm.kernels.monitor import N_AUX, phi_ecc, phi_sc, simulate_lf, simulate_lf_many
-from emaphm.monitor import MonitorEma
+from emaphm import MonitorEma
+from emaphm.kernels import monitor as lf_kernel
+from emaphm.kernels.monitor import (
+    IDX,
+    LF_FIELDS,
+    N_AUX,
+    N_FIELDS,
+    phi_ecc,
+    phi_sc,
+    simulate_lf,
+    simulate_lf_many,
+)
 
 THETA = np.linspace(0, 2 * np.pi, 720, endpoint=False)
 
@@ -58,3 +68,16 @@ def test_population_kernel_is_bit_identical_to_single_runs():
         simulate_lf(theta_cmd, rows[r], single, np.empty((0, N_AUX)))
         np.testing.assert_array_equal(single, many[r])
     assert not np.array_equal(many[0], many[1])
+
+
+def test_index_constants_match_the_row_layout():
+    # the kernel reads a row through hand-written constants (F_S, J, ..., N_LF); each must be the
+    # position of its field in LF_FIELDS, or the LF model silently reads the wrong physics (A3)
+    assert len(set(LF_FIELDS)) == len(LF_FIELDS) == N_FIELDS
+    assert IDX == {name: j for j, name in enumerate(LF_FIELDS)}
+    for j, name in enumerate(LF_FIELDS):
+        assert getattr(lf_kernel, name.upper()) == j, name
+    # and no other upper-case integer constant pretends to be a field index
+    others = {"N_FIELDS", "N_AUX"}
+    constants = {n for n, v in vars(lf_kernel).items() if n.isupper() and type(v) is int and n not in others}
+    assert constants == {name.upper() for name in LF_FIELDS}

@@ -19,19 +19,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from pymoo.algorithms.soo.nonconvex.ga import GA
-from pymoo.core.callback import Callback
-from pymoo.core.problem import Problem
-from pymoo.optimize import minimize
 
 from .._version import __version__
+from .._versions import versions
 from ..calibration import COEFFICIENT_BOUNDS, Calibration, Coefficients
 from ..commands import Chirp, Command, command_record
 from ..errors import InputError
 from ..faults import HEALTHY, as_fault_vector
 from ..kernels.monitor import simulate_lf_many
-from ..models import HighFidelityEma, check_seed
-from ..monitor import monitor_rows
+from ..models import HighFidelityEma, check_seed, monitor_rows
 from ..params import EmaParams
+from .optimizers import BatchProblem, minimize_batch
 from .signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 
 __all__ = ["CHECK_SCENARIOS", "FIT_SCENARIOS", "Scenario", "calibrate", "scenario_nrmse"]
@@ -122,30 +120,6 @@ def scenario_nrmse(
     return out
 
 
-class _CalibrationProblem(Problem):  # type: ignore[misc]
-    """Mean NRMSE over the fitting scenarios as a function of the coefficient vector."""
-
-    def __init__(self, evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]]) -> None:
-        lo, hi = zip(*COEFFICIENT_BOUNDS.values(), strict=True)
-        super().__init__(n_var=len(lo), n_obj=1, xl=np.array(lo), xu=np.array(hi))
-        self._f = evaluate
-
-    def _evaluate(self, X: NDArray[np.float64], out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
-        out["F"] = self._f(X)
-
-
-class _Report(Callback):  # type: ignore[misc]
-    def __init__(self, progress: Progress | None, generations: int) -> None:
-        super().__init__()
-        self.progress, self.generations = progress, generations
-        self.history: list[float] = []
-
-    def notify(self, algorithm: Any) -> None:
-        self.history.append(float(algorithm.pop.get("F").min()))
-        if self.progress:
-            self.progress("GA generations", algorithm.n_gen, self.generations)
-
-
 def calibrate(
     *,
     seed: int = 1,
@@ -162,7 +136,8 @@ def calibrate(
 
     The HF references are noise-free (the twin's deterministic response); the held-out check is
     also reported with noise on (seed `seed`). Returns a `Calibration` whose record holds the
-    scenario sets, the NRMSE of each, the seed, the settings, the GA history and the version.
+    scenario sets, the NRMSE of each, the seed, the settings, the GA history and the versions of
+    emaphm, Python and the numerical packages.
     """
     seed = check_seed(seed)
     for name, value, least in (("pop_size", pop_size, 4), ("generations", generations, 1), ("n_lf", n_lf, 1)):
@@ -181,13 +156,18 @@ def calibrate(
         coeffs = [Coefficients.from_vector(x) for x in X]
         return scenario_nrmse(coeffs, fit, fit_refs, params, theta_cmd, n_lf).mean(axis=1)
 
-    report = _Report(progress, generations)
-    res = minimize(
-        _CalibrationProblem(objective), GA(pop_size=pop_size), ("n_gen", generations),
-        seed=seed, verbose=False, callback=report,
-    )  # fmt: skip
-    lo, hi = (np.array(b) for b in zip(*COEFFICIENT_BOUNDS.values(), strict=True))
-    best = Coefficients.from_vector(np.clip(res.X, lo, hi))
+    def on_generation(generation: int, total: int, best: float) -> None:
+        if progress:
+            progress("GA generations", generation, total)
+
+    # the mean NRMSE over the fitting scenarios as a function of the coefficient vector
+    lo, hi = zip(*COEFFICIENT_BOUNDS.values(), strict=True)
+    problem = BatchProblem(objective, lo, hi)
+    # a fixed number of generations: no early stop
+    x, _, history = minimize_batch(
+        problem, GA(pop_size=pop_size), generations, seed=seed, on_generation=on_generation
+    )
+    best = Coefficients.from_vector(x)
     fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, theta_cmd, n_lf)[0]
     check_nrmse = scenario_nrmse([best], check, check_refs, params, theta_cmd, n_lf)[0]
     check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, theta_cmd, n_lf)[0]
@@ -203,13 +183,17 @@ def calibrate(
 
     record = {
         "package_version": __version__,
+        "versions": versions(),
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "seed": seed,
         "settings": {
-            "optimizer": "pymoo GA (real-coded, SBX + polynomial mutation)",
+            "optimizer": (
+                "pymoo GA, real-coded: binary tournament, SBX crossover, polynomial mutation, "
+                "elitist survival, duplicates eliminated; all generations run (no early stop)"
+            ),
             "pop_size": pop_size,
             "generations": generations,
-            "evaluations": int(res.algorithm.evaluator.n_eval),
+            "evaluations": problem.evaluations,
             "objective": "mean NRMSE over the fitting scenarios (HF noise off)",
             "nrmse": "||I_HF - I_LF|| / ||I_HF - mean(I_HF)||, both filtered",
             "filter": f"Butterworth order {FILTER_ORDER}, {CUTOFF_HZ:g} Hz, zero phase (sosfiltfilt)",
@@ -218,7 +202,7 @@ def calibrate(
             "params": params.to_dict(),
             "wall_time_s": round(time.perf_counter() - start, 2),
         },
-        "ga_history": report.history,
+        "ga_history": history,
         "fit_scenarios": table(fit, fit_nrmse),
         "check_scenarios": table(check, check_nrmse),
         "check_scenarios_noise_on": table(check, check_noisy),

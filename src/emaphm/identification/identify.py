@@ -1,6 +1,6 @@
 """Fault identification (paper §5, DESIGN §5): the fault vector whose LF current best fits a measurement.
 
-`FaultIdentifier` (scikit-learn style: `fit` stores `faults_`, `fitness_`, `result_`) fits the
+`FaultIdentifier` (scikit-learn style: `fit` stores `faults_`, `fitness_`, `run_`, `wall_time_`) fits the
 calibrated monitor model to a measured i_q trace: the optimiser proposes populations of fault
 vectors in [0, 1]^8, each generation is one call of the LF population kernel, and the fitness is
 eq. (3) on the comparison pipeline. `identify` is the library mirror of ``emaphm identify``.
@@ -19,13 +19,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._threads import numba_threads
 from .._version import __version__
+from .._versions import versions
+from ..calibration import Calibration
 from ..commands import Chirp, Command, SampledCommand
 from ..errors import InputError
 from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
-from ..kernels.monitor import simulate_lf_many
-from ..models import HighFidelityEma, check_seed
-from ..monitor import MonitorEma
+from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..results import SimResult
 from .detection import detect
 from .fitness import Fitness
@@ -36,6 +36,9 @@ from .signals import Comparison
 __all__ = ["MIN_SAMPLES", "FaultIdentifier", "IdentificationResult", "identify", "search_to_faults"]
 
 MIN_SAMPLES = 200  # a reference shorter than this (20 ms at 10 kHz) cannot show the faults
+# the comparison spans at most this: a population holds pop_size x samples currents (96 x 1e6 x 8 B
+# = 0.8 GB at 100 s), and a longer span is more often a time axis in ms than a real recording
+MAX_SPAN = 100.0
 
 
 @dataclass(frozen=True)
@@ -76,7 +79,8 @@ class IdentificationResult:
             "optimizer": self.optimizer,
             "version": self.version,
             "settings": self.settings,
-            "history": self.history,
+            # a generation whose best row diverged has no finite best: null, so the JSON stays valid
+            "history": [float(v) if np.isfinite(v) else None for v in self.history],
         }
 
 
@@ -139,16 +143,27 @@ class FaultIdentifier:
             raise InputError(f"the reference has {len(t)} samples; at least {MIN_SAMPLES} are needed")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(i_q))):
             raise InputError("the reference contains NaN or inf")
+        span = float(t[-1] - t[0])
+        if span > MAX_SPAN:
+            raise InputError(
+                f"the reference spans {span:g} s; at most {MAX_SPAN:g} s can be compared "
+                "(is the time axis in seconds?)"
+            )
         base = self.monitor if self.monitor is not None else MonitorEma()
-        monitor = MonitorEma(base.params, command if command is not None else base.command, base.calibration)
-        grid, theta_cmd = monitor.sample_grid(min(float(t[-1] - t[0]), monitor.command.duration))
+        monitor = MonitorEma(
+            base.params,
+            command if command is not None else base.command,
+            base.calibration,
+            allow_mismatch=True,
+        )  # base was checked when it was built
+        duration = min(span, monitor.command.duration)
+        grid, _ = monitor.sample_grid(duration)
         reference = Comparison.from_trace(t - t[0], i_q, grid, monitor.params.controller.f_s)
         fitness = Fitness(reference, self.slope_unit)
 
         def evaluate(X: NDArray[np.float64]) -> NDArray[np.float64]:
-            currents = np.empty((len(X), len(theta_cmd)))
-            simulate_lf_many(theta_cmd, monitor.rows(search_to_faults(X)), currents)
-            return fitness(currents)
+            # a diverged row gets a non-finite fitness, which the optimisers rank last
+            return fitness(monitor.simulate_many(search_to_faults(X), duration=duration, check=False))
 
         start = time.perf_counter()
         run: OptimizerRun = run_optimizer(
@@ -189,15 +204,19 @@ def identify(
     slope_unit: str = "s",
     on_generation: OnGeneration | None = None,
     thresholds: dict[str, float] | None = None,
+    calibration: Calibration | str | os.PathLike[str] | None = None,
 ) -> IdentificationResult:
     """Identify the faults from `reference` (a trace file or `SimResult`), or from the HF twin run
     with `true_faults` and noise on (DESIGN §8). Exactly one of the two must be given.
 
     `seed` is split (numpy SeedSequence) into the twin's noise seed and the optimiser's seed.
-    `thresholds` overrides the shipped detection thresholds ({} reports nothing).
+    `thresholds` overrides the shipped detection thresholds ({} reports nothing). `calibration`
+    is the LF calibration (a `Calibration` or the path of a file from ``emaphm calibrate``; the
+    packaged one by default); one made for other actuator parameters raises `InputError`.
     """
     seed = check_seed(seed)
     check_optimizer(optimizer)  # before the twin runs
+    monitor = MonitorEma(calibration=calibration)  # a calibration that does not fit: before the work
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -219,7 +238,7 @@ def identify(
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
-        slope_unit=slope_unit, on_generation=on_generation,
+        slope_unit=slope_unit, monitor=monitor, on_generation=on_generation,
     )  # fmt: skip
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command)
@@ -235,7 +254,16 @@ def identify(
         "slope_unit": slope_unit,
         "workers": workers,
         "optimizer_wall_time_s": round(ident.wall_time_, 3),
-        "calibration": MonitorEma().calibration.record.get("created"),
+        "calibration": {
+            "source": "packaged"
+            if calibration is None
+            else str(calibration)
+            if not isinstance(calibration, Calibration)
+            else "Calibration object",
+            "created": monitor.calibration.record.get("created"),
+            "params_hash": monitor.calibration.params_hash,
+        },
+        "versions": versions(),
     }
     return IdentificationResult(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=run.evaluations,

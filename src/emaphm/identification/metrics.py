@@ -12,6 +12,10 @@ of Table 1 to two decimals weights the phase error by k̄6 *inside* the square:
 It is also the physically sensible one: the eccentricity phase k7 only matters in proportion to the
 eccentricity k̄6 (a direction error of a vanishing eccentricity is no error), and the term has
 the units of the others. It is the default (`form="table1"`); `form="printed"` gives eq. 4 as printed.
+
+In both forms k7 − k̄7 is taken on the circle, wrapped to [−0.5, 0.5): k7 is a direction
+φ_e = 2π·k7, so 0.99 against 0.01 is a 0.02 error, not 0.98. The five Table 1 rows are
+unaffected (their phase errors are below 0.5).
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 from ..faults import as_fault_vector
 
-__all__ = ["absolute_errors", "percent_error"]
+__all__ = ["absolute_errors", "percent_error", "wrap_phase"]
 
 
 def percent_error(
@@ -34,6 +38,7 @@ def percent_error(
     k = as_fault_vector(estimate, name="estimate")
     kt = as_fault_vector(truth, name="truth")
     d = k - kt
+    d[6] = wrap_phase(d[6])
     core = float(np.sum(d[[0, 1, 2, 3, 4, 5, 7]] ** 2))
     if form == "table1":
         return 100.0 * float(np.sqrt(core + (kt[5] * d[6]) ** 2))
@@ -42,8 +47,13 @@ def percent_error(
     raise InputError(f"unknown %err form {form!r}; use 'table1' or 'printed'")
 
 
+def wrap_phase(dk7: float) -> float:
+    """A difference of k7 (a phase in turns) wrapped to [−0.5, 0.5)."""
+    return float((dk7 + 0.5) % 1.0 - 0.5)
+
+
 def absolute_errors(estimate: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:
     """|k_i − k̄_i| per fault (k7's difference taken on the circle: the phase wraps at 1)."""
     d = np.abs(as_fault_vector(estimate, name="estimate") - as_fault_vector(truth, name="truth"))
-    d[6] = min(d[6], 1.0 - d[6])
+    d[6] = abs(wrap_phase(d[6]))
     return d

@@ -1,11 +1,16 @@
-"""Optimisers over the box [0, 1]^n, each evaluating a whole population per call (DESIGN §5).
+"""Optimisers over a box, each evaluating a whole population per call (DESIGN §5).
 
 GA, DE, PSO and CMA-ES come from pymoo; the grey wolf optimiser (GWO, Mirjalili et al. 2014) is
 our own, vectorised and seeded. Every optimiser takes the same batch objective
 ``evaluate(X: (m, n)) -> (m,)``, stops at its generation budget or earlier when the best value has
-stagnated, reports each generation to a callback, and returns an `OptimizerRun`. The local polish
-(on by default in `identify`) refines the best point with a small CMA-ES, also one batch per
-generation.
+stagnated (`Stagnation`), reports each generation to a callback, and returns an `OptimizerRun`.
+The local polish (on by default in `identify`) refines the best point with a small CMA-ES, also
+one batch per generation.
+
+The pieces shared with the calibration (`calibrate.py`): `BatchProblem` (the pymoo problem of a
+batch objective on a box; it counts evaluations and turns any non-finite value into +inf) and
+`GenerationLog` (the pymoo callback that records the best value of each generation and reports
+it).
 
 The GA is real-coded with the parent-centric crossover PCX (Deb et al. 2002) instead of pymoo's
 default SBX. The three coil shorts act on the current through a linear mix of (k3, k4, k5): a
@@ -17,23 +22,33 @@ Table 1 case). PCX is rotation-invariant and found the right basin in every seed
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from pymoo.core.callback import Callback
+from pymoo.core.population import Population
 from pymoo.core.problem import Problem
+from pymoo.core.termination import TerminateIfAny, Termination
 from pymoo.optimize import minimize
+from pymoo.termination.ftol import SingleObjectiveSpaceTermination
+from pymoo.termination.max_gen import MaximumGenerationTermination
+from pymoo.termination.robust import RobustTermination
 
 from ..errors import InputError
 
 __all__ = [
     "DEFAULT_BUDGETS",
     "OPTIMIZERS",
+    "POLISH_BUDGET",
+    "BatchProblem",
+    "GenerationLog",
     "OptimizerRun",
+    "RelativeObjectiveTermination",
     "Stagnation",
     "check_optimizer",
+    "minimize_batch",
     "polish",
     "run_optimizer",
 ]
@@ -42,9 +57,10 @@ Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 OnGeneration = Callable[[int, int, float], None]  # (generation, max generations, best value)
 
 OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo")
-# (population, max generations) of the global search: 3840 evaluations for every optimiser. The
-# GA gets a wider, shorter run: at 64 x 60 it ended in a wrong basin in 4 of 10 seeds on the
-# Table 1 case, at 96 x 40 in none (benchmarks: docs/identification.md §3)
+# (population, max generations) of the global search, ≈ 3840 evaluations for every optimiser
+# (CMA-ES: 1 + 64 × 59, its first generation is the start point; GWO: 64 × 61, its initial pack is
+# evaluated before the first generation). The GA gets a wider, shorter run: at 64 x 60 it ended in
+# a wrong basin in 4 of 10 seeds on the Table 1 case, at 96 x 40 in none (docs/identification.md §3)
 DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "ga": (96, 40),
     "de": (64, 60),
@@ -55,21 +71,62 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
 
 
-@dataclass
+@dataclass(frozen=True)
 class Stagnation:
-    """Stop when the best value has improved by less than `rtol` (relative) over `patience` generations."""
+    """The early stop: `patience` generations in a row without a relative improvement above `rtol`.
+
+    Settings only; `termination` makes the pymoo termination that applies them.
+    """
 
     patience: int = 25
     rtol: float = 1e-3
-    history: list[float] = field(default_factory=list)
 
-    def update(self, best: float) -> bool:
-        """Record this generation's best; True when the run should stop."""
-        self.history.append(best)
-        if len(self.history) <= self.patience:
-            return False
-        old = self.history[-self.patience - 1]
-        return old - best <= self.rtol * abs(old)
+    def __post_init__(self) -> None:
+        if not (isinstance(self.patience, int | np.integer) and self.patience >= 1):
+            raise InputError(f"patience must be a whole number >= 1, got {self.patience!r}")
+        if not (np.isfinite(self.rtol) and self.rtol >= 0):
+            raise InputError(f"rtol must be finite and >= 0, got {self.rtol!r}")
+
+    def termination(self, generations: int) -> Termination:
+        """pymoo's termination: at `generations`, or earlier by this rule (fresh state per run).
+
+        pymoo's `RobustTermination(SingleObjectiveSpaceTermination(tol), period)` with a relative
+        tolerance. The objective-space termination keeps a reference best value: a generation
+        whose best is within rtol·|reference| of it counts as stagnant; one that improves on it by
+        more becomes the new reference. The robust wrapper stops after `patience` stagnant
+        generations in a row, so at generation g when best(g − patience) − best(g) ≤
+        rtol·|best(g − patience)| and no generation in between improved by more than rtol on the
+        reference; at the earliest at generation patience + 1. A non-finite best never stops it.
+        """
+        return TerminateIfAny(
+            MaximumGenerationTermination(generations),
+            RobustTermination(RelativeObjectiveTermination(self.rtol), period=self.patience),
+        )
+
+
+class RelativeObjectiveTermination(SingleObjectiveSpaceTermination):  # type: ignore[misc]
+    """pymoo's `SingleObjectiveSpaceTermination` with a relative tolerance: the improvement of the
+    best value on the reference, divided by |reference| (pymoo divides by nothing)."""
+
+    def _delta(self, prev: float, current: float) -> float:
+        if not (np.isfinite(prev) and np.isfinite(current)):
+            return np.inf
+        gain = max(0.0, prev - current)
+        if prev == 0.0:
+            return 0.0 if gain == 0.0 else np.inf
+        return gain / abs(prev)
+
+
+@dataclass
+class _LoopState:
+    """What pymoo's terminations read from an algorithm, for a loop of our own (the GWO)."""
+
+    n_gen: int
+    best: float
+
+    @property
+    def opt(self) -> Any:
+        return Population.new("F", np.array([[self.best]]))
 
 
 @dataclass(frozen=True)
@@ -82,29 +139,85 @@ class OptimizerRun:
     history: list[float]
 
 
-class _BatchProblem(Problem):  # type: ignore[misc]
-    def __init__(self, evaluate: Objective, n_var: int, counter: list[int]) -> None:
-        super().__init__(n_var=n_var, n_obj=1, xl=np.zeros(n_var), xu=np.ones(n_var))
-        self._evaluate_batch, self._counter = evaluate, counter
+class BatchProblem(Problem):  # type: ignore[misc]
+    """Minimise a batch objective ``evaluate(X: (m, n)) -> (m,)`` over the box [xl, xu].
+
+    Points are clipped to the box before they are evaluated. Any non-finite value (NaN, ±inf)
+    becomes +inf, the worst possible, so it never ranks above a finite one (a NaN would make the
+    optimisers' sorting and comparisons arbitrary, a −inf would win). `evaluations` counts the
+    points evaluated.
+    """
+
+    def __init__(self, evaluate: Objective, xl: ArrayLike, xu: ArrayLike) -> None:
+        xl, xu = np.asarray(xl, dtype=np.float64), np.asarray(xu, dtype=np.float64)
+        if xl.ndim != 1 or xl.shape != xu.shape or not np.all(xl < xu):
+            raise InputError(f"bounds must be two equal-length vectors with xl < xu, got {xl} and {xu}")
+        super().__init__(n_var=len(xl), n_obj=1, xl=xl, xu=xu)
+        self.objective = evaluate
+        self.evaluations = 0
 
     def _evaluate(self, X: NDArray[np.float64], out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
-        self._counter[0] += len(X)
-        out["F"] = self._evaluate_batch(np.clip(X, 0.0, 1.0))
+        out["F"] = self.evaluate_batch(X)
+
+    def evaluate_batch(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Values of the rows of X (clipped to the box), non-finite ones as +inf; counted."""
+        X = np.clip(X, self.xl, self.xu)
+        f = np.asarray(self.objective(X), dtype=np.float64).reshape(len(X))
+        self.evaluations += len(X)
+        return np.where(np.isfinite(f), f, np.inf)
 
 
-class _Monitor(Callback):  # type: ignore[misc]
-    def __init__(self, stop: Stagnation, generations: int, on_generation: OnGeneration | None) -> None:
+def best_value(algorithm: Any) -> float:
+    """The best objective value a pymoo algorithm holds (its optimum and its population)."""
+    best = float(np.min(algorithm.pop.get("F")))
+    if algorithm.opt is not None and len(algorithm.opt):
+        best = min(best, float(algorithm.opt.get("F").min()))
+    return best
+
+
+class GenerationLog(Callback):  # type: ignore[misc]
+    """pymoo callback: records the best value of each generation and reports it.
+
+    `on_generation(generation, generations, best)` is called once per generation; `record` does
+    the same for a loop that is not a pymoo algorithm (the GWO).
+    """
+
+    def __init__(self, generations: int, on_generation: OnGeneration | None = None) -> None:
         super().__init__()
-        self.stop, self.generations, self.on_generation = stop, generations, on_generation
+        self.generations, self.on_generation = generations, on_generation
+        self.history: list[float] = []
+
+    def record(self, generation: int, best: float) -> None:
+        self.history.append(best)
+        if self.on_generation is not None:
+            self.on_generation(generation, self.generations, best)
 
     def notify(self, algorithm: Any) -> None:
-        best = float(np.min(algorithm.pop.get("F")))
-        if algorithm.opt is not None and len(algorithm.opt):
-            best = min(best, float(algorithm.opt.get("F").min()))
-        if self.on_generation:
-            self.on_generation(algorithm.n_gen, self.generations, best)
-        if self.stop.update(best):
-            algorithm.termination.force_termination = True
+        self.record(algorithm.n_gen, best_value(algorithm))
+
+
+def minimize_batch(
+    problem: BatchProblem,
+    algorithm: Any,
+    generations: int,
+    *,
+    seed: int,
+    stagnation: Stagnation | None = None,
+    on_generation: OnGeneration | None = None,
+) -> tuple[NDArray[np.float64], float, list[float]]:
+    """Run a pymoo `algorithm` on `problem` for at most `generations` (fewer if it stagnates).
+
+    Returns the best point (clipped to the box), its value and the best value per generation.
+    """
+    termination: Termination = (
+        MaximumGenerationTermination(generations)
+        if stagnation is None
+        else stagnation.termination(generations)
+    )
+    log = GenerationLog(generations, on_generation)
+    res = minimize(problem, algorithm, termination, seed=seed, verbose=False, callback=log)
+    x = np.clip(np.atleast_2d(res.X)[0], problem.xl, problem.xu)
+    return x, float(np.atleast_1d(res.F)[0]), log.history
 
 
 def check_optimizer(name: str) -> str:
@@ -114,7 +227,7 @@ def check_optimizer(name: str) -> str:
     return name
 
 
-def _pymoo_algorithm(name: str, pop_size: int, n_var: int, rng: np.random.Generator) -> Any:
+def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator) -> Any:
     if name == "ga":
         from pymoo.algorithms.soo.nonconvex.ga import GA
         from pymoo.operators.crossover.pcx import PCX
@@ -129,10 +242,16 @@ def _pymoo_algorithm(name: str, pop_size: int, n_var: int, rng: np.random.Genera
 
         return PSO(pop_size=pop_size)
     if name == "cmaes":
-        from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
-
-        return CMAES(x0=rng.uniform(0.2, 0.8, n_var), sigma=0.3, popsize=pop_size, restarts=0)
+        return _cmaes(rng.uniform(0.2, 0.8, n_var), 0.3, pop_size, generations)
     raise AssertionError(f"no pymoo algorithm for {name!r}")  # names are checked before
+
+
+def _cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int) -> Any:
+    from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+
+    # pymoo passes the generation budget on to the `cma` package only when the termination is a
+    # bare MaximumGenerationTermination; give it explicitly, as it is combined with the early stop
+    return CMAES(x0=x0, sigma=sigma, popsize=pop_size, restarts=0, maxiter=generations)
 
 
 def run_optimizer(
@@ -146,7 +265,10 @@ def run_optimizer(
     stagnation: Stagnation | None = None,
     on_generation: OnGeneration | None = None,
 ) -> OptimizerRun:
-    """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`)."""
+    """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`).
+
+    Stops at `generations` or when `stagnation` (default `Stagnation()`) says so.
+    """
     check_optimizer(name)
     default_pop, default_gen = DEFAULT_BUDGETS[name]
     pop_size = default_pop if pop_size is None else pop_size
@@ -157,41 +279,37 @@ def run_optimizer(
         )
     stop = stagnation if stagnation is not None else Stagnation()
     rng = np.random.default_rng(seed)
+    problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     if name == "gwo":
-        return _grey_wolf(evaluate, n_var, pop_size, generations, rng, stop, on_generation)
-    counter = [0]
-    res = minimize(
-        _BatchProblem(evaluate, n_var, counter),
-        _pymoo_algorithm(name, pop_size, n_var, rng),
-        ("n_gen", generations),
-        seed=seed,
-        verbose=False,
-        callback=_Monitor(stop, generations, on_generation),
-    )
-    x = np.clip(np.atleast_2d(res.X)[0], 0.0, 1.0)
-    return OptimizerRun(x, float(np.atleast_1d(res.F)[0]), counter[0], list(stop.history))
+        return _grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
+    x, f, history = minimize_batch(
+        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng), generations,
+        seed=seed, stagnation=stop, on_generation=on_generation,
+    )  # fmt: skip
+    return OptimizerRun(x, f, problem.evaluations, history)
 
 
 def _grey_wolf(
-    evaluate: Objective,
-    n_var: int,
+    problem: BatchProblem,
     pack: int,
     generations: int,
     rng: np.random.Generator,
-    stop: Stagnation,
+    stagnation: Stagnation,
     on_generation: OnGeneration | None,
 ) -> OptimizerRun:
     """Grey wolf optimiser: the pack moves towards the three best wolves (α, β, δ).
 
     a falls linearly from 2 to 0; each leader L pulls a wolf to L − A·|C·L − X| with
     A = 2a·r1 − a and C = 2·r2 (r uniform in [0, 1]); the new position is the mean of the three
-    pulls, clipped to the box. The leaders are the best points seen so far.
+    pulls, clipped to the box. The leaders are the best points seen so far. The initial pack is
+    evaluated before generation 1.
     """
-    X = rng.uniform(0.0, 1.0, (pack, n_var))
-    F = evaluate(X)
-    evaluations = pack
+    lo, hi = problem.xl, problem.xu
+    X = rng.uniform(lo, hi, (pack, problem.n_var))
+    F = problem.evaluate_batch(X)
     order = np.argsort(F)
     leaders, leader_f = X[order[:3]].copy(), F[order[:3]].copy()
+    log, stop = GenerationLog(generations, on_generation), stagnation.termination(generations)
     for gen in range(1, generations + 1):
         a = 2.0 * (1.0 - (gen - 1) / max(generations - 1, 1))
         pulls = np.zeros_like(X)
@@ -199,17 +317,16 @@ def _grey_wolf(
             A = 2.0 * a * rng.uniform(size=X.shape) - a
             C = 2.0 * rng.uniform(size=X.shape)
             pulls += L - A * np.abs(C * L - X)
-        X = np.clip(pulls / 3.0, 0.0, 1.0)
-        F = evaluate(X)
-        evaluations += pack
+        X = np.clip(pulls / 3.0, lo, hi)
+        F = problem.evaluate_batch(X)
         pool_x, pool_f = np.vstack([leaders, X]), np.concatenate([leader_f, F])
         best = np.argsort(pool_f)[:3]
         leaders, leader_f = pool_x[best].copy(), pool_f[best].copy()
-        if on_generation:
-            on_generation(gen, generations, float(leader_f[0]))
-        if stop.update(float(leader_f[0])):
+        log.record(gen, float(leader_f[0]))
+        stop.update(_LoopState(gen, float(leader_f[0])))
+        if stop.has_terminated():
             break
-    return OptimizerRun(leaders[0].copy(), float(leader_f[0]), evaluations, list(stop.history))
+    return OptimizerRun(leaders[0].copy(), float(leader_f[0]), problem.evaluations, log.history)
 
 
 def polish(
@@ -224,22 +341,16 @@ def polish(
 ) -> OptimizerRun:
     """Refine a run's best point with a small CMA-ES around it (step `sigma` in the unit box).
 
+    Budget `POLISH_BUDGET`; stops early by `stagnation` (default `Stagnation(patience=15)`).
     Keeps the start point if the polish finds nothing better; the history continues the start's.
     """
-    from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
-
     pop_size, generations = POLISH_BUDGET
     stop = stagnation if stagnation is not None else Stagnation(patience=15)
-    counter = [0]
-    res = minimize(
-        _BatchProblem(evaluate, n_var, counter),
-        CMAES(x0=np.clip(start.x, 0.0, 1.0), sigma=sigma, popsize=pop_size, restarts=0),
-        ("n_gen", generations),
-        seed=seed,
-        verbose=False,
-        callback=_Monitor(stop, generations, on_generation),
-    )
-    x, f = np.clip(np.atleast_2d(res.X)[0], 0.0, 1.0), float(np.atleast_1d(res.F)[0])
-    if f >= start.f:
+    problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
+    x, f, history = minimize_batch(
+        problem, _cmaes(np.clip(start.x, 0.0, 1.0), sigma, pop_size, generations), generations,
+        seed=seed, stagnation=stop, on_generation=on_generation,
+    )  # fmt: skip
+    if not f < start.f:
         x, f = start.x, start.f
-    return OptimizerRun(x, f, start.evaluations + counter[0], [*start.history, *stop.history])
+    return OptimizerRun(x, f, start.evaluations + problem.evaluations, [*start.history, *history])

@@ -68,7 +68,10 @@ class Comparison:
             raise InputError(f"the reference has {len(t)} samples; at least 20 are needed to filter it")
         if not np.all(np.isfinite(i_q)):
             raise InputError("the reference current contains NaN or inf")
-        return cls(t, lowpass(i_q, f_s), f_s)
+        reference = lowpass(i_q, f_s)
+        if not np.ptp(reference) > 0.0:  # NRMSE divides by its spread
+            raise InputError("the reference current is constant: there is nothing to compare")
+        return cls(t, reference, f_s)
 
     @classmethod
     def from_trace(cls, t_src: ArrayLike, i_q_src: ArrayLike, t_grid: ArrayLike, f_s: float) -> Comparison:

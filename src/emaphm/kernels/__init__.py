@@ -2,7 +2,7 @@
 
 Pure functions of floats, arrays and `NamedTuple` parameter packs whose field names are the
 paper's symbols. This sub-package imports nothing from the rest of emaphm; the API layer
-(`emaphm.models`) validates input, packs parameters and calls these kernels.
+(`emaphm.models`: `hf.py`, `lf.py`) validates input, packs parameters and calls these kernels.
 
 Layout (the block diagram): `controller` (ACE position PID), `pmsm_abc` (hysteresis inverter and
 three-phase stator), `mechanics` (gearbox, friction, backlash, end-stops), `sensors` (ADC),

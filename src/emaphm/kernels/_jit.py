@@ -1,21 +1,105 @@
-"""The one decorator every kernel goes through."""
+"""The one decorator every kernel goes through, and where its compiled code is cached.
+
+numba's on-disk cache stamps a cached function with its *own* source file only: after an edit
+to `mechanics.py`, `hf_twin.simulate_hf` (which inlines `mechanics_step`) would keep running the
+old machine code (numba issues #8396, #9563). emaphm's kernels therefore use their own cache
+locator: the cache folder and every function's source stamp are keyed by one hash of *all*
+kernel sources (`KERNEL_SOURCE_HASH`), so any edit to any kernel file recompiles every kernel.
+
+The cache lives in ``$NUMBA_CACHE_DIR/emaphm-kernels-<hash>`` when the user set
+``NUMBA_CACHE_DIR``, else in ``$XDG_CACHE_HOME/emaphm/numba-<hash>`` (``~/.cache/...``). When
+no such folder can be written, the kernels compile in memory on every run (slower start, never
+stale).
+"""
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, TypeVar
 
-from numba import njit
+from numba import config, njit
+from numba.core import caching
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+KERNEL_DIR = Path(__file__).resolve().parent
+
+
+def kernel_source_hash(folder: Path = KERNEL_DIR) -> str:
+    """SHA-256 over the names and contents of every ``*.py`` file in the kernel folder."""
+    h = hashlib.sha256()
+    for path in sorted(folder.glob("*.py")):
+        h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+KERNEL_SOURCE_HASH = kernel_source_hash()
+
+
+def kernel_cache_dir() -> Path:
+    """The folder for this set of kernel sources (see the module docstring)."""
+    key = KERNEL_SOURCE_HASH[:16]
+    user_dir = getattr(config, "CACHE_DIR", "")  # NUMBA_CACHE_DIR, as numba read it
+    if user_dir:
+        return Path(user_dir) / f"emaphm-kernels-{key}"
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "emaphm" / f"numba-{key}"
+
+
+def _writable(folder: Path) -> bool:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:
+        return False
+    return True
+
+
+class KernelCacheLocator(caching._CacheLocator):  # type: ignore[misc]
+    """numba cache locator for the files in this folder: stamped by the hash of all of them."""
+
+    def __init__(self, py_func: Any, py_file: str) -> None:
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = str(kernel_cache_dir())
+
+    def get_cache_path(self) -> str:
+        return self._cache_path
+
+    def get_source_stamp(self) -> str:
+        return KERNEL_SOURCE_HASH
+
+    def get_disambiguator(self) -> str:
+        return str(self._lineno)
+
+    @classmethod
+    def from_function(cls, py_func: Any, py_file: str) -> KernelCacheLocator | None:
+        try:
+            if Path(py_file).resolve().parent != KERNEL_DIR:
+                return None  # not an emaphm kernel: numba's own locators decide
+        except OSError:
+            return None
+        return cls(py_func, py_file)
+
+
+# the class that lists numba's locators: CacheImpl in recent releases, _CacheImpl in older ones
+_CACHE_IMPL: Any = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")  # noqa: B009
+if KernelCacheLocator not in _CACHE_IMPL._locator_classes:
+    _CACHE_IMPL._locator_classes.insert(0, KernelCacheLocator)
+
+CACHE_ENABLED = _writable(kernel_cache_dir())
 
 
 def jit(fn: F | None = None, *, parallel: bool = False) -> Any:
     """``numba.njit`` with the project's settings.
 
-    ``cache=True`` keeps compiled code on disk between runs; ``error_model="numpy"`` drops the
-    division-by-zero checks from the hot loops (the API validates the divisors); ``fastmath`` stays
-    off so results are bit-reproducible.
+    ``cache=True`` keeps compiled code on disk between runs (in `kernel_cache_dir`, keyed by all
+    kernel sources); ``error_model="numpy"`` drops the division-by-zero checks from the hot loops
+    (the API validates the divisors, and the model layer checks outputs for NaN/inf);
+    ``fastmath`` stays off so results are bit-reproducible.
     """
-    decorator = njit(cache=True, parallel=parallel, error_model="numpy")
+    decorator = njit(cache=CACHE_ENABLED, parallel=parallel, error_model="numpy")
     return decorator if fn is None else decorator(fn)

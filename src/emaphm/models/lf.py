@@ -4,21 +4,31 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .calibration import Calibration, Coefficients, default_calibration
-from .commands import Command
-from .faults import HEALTHY, as_fault_matrix, as_fault_vector, fault_parameter_columns
-from .kernels.monitor import AUX_COLUMNS, IDX, N_AUX, N_FIELDS, simulate_lf, simulate_lf_many
-from .kernels.sensors import adc
-from .models import _EmaModel, check_seed
-from .params import EmaParams
-from .results import SimResult
+from ..calibration import Calibration, Coefficients, default_calibration, load_calibration
+from ..commands import Command
+from ..faults import HEALTHY, as_fault_matrix, as_fault_vector, fault_parameter_columns
+from ..kernels.monitor import AUX_COLUMNS, IDX, N_AUX, N_FIELDS, simulate_lf, simulate_lf_many
+from ..kernels.sensors import adc
+from ..params import EmaParams
+from ..results import SimResult
+from ._base import _EmaModel, check_finite, check_seed
 
-__all__ = ["MonitorEma", "monitor_rows"]
+__all__ = ["MonitorEma", "monitor_rows", "resolve_calibration"]
+
+
+def resolve_calibration(calibration: Calibration | str | os.PathLike[str] | None) -> Calibration:
+    """A `Calibration` from itself, a calibration file's path, or None (the packaged one)."""
+    if calibration is None:
+        return default_calibration()
+    if isinstance(calibration, Calibration):
+        return calibration
+    return load_calibration(calibration)
 
 
 def monitor_rows(
@@ -67,8 +77,11 @@ class MonitorEma(_EmaModel):
         Nominal parameters: the LF model shares the drive train and controller with the HF twin.
     command : Command
         Position command; the FDI chirp by default.
-    calibration : Calibration
-        Coefficients of the equivalent motor; the packaged calibration by default.
+    calibration : Calibration or path, optional
+        Coefficients of the equivalent motor: a `Calibration`, the path of a file written by
+        ``emaphm calibrate``, or None for the packaged calibration. A calibration belongs to one
+        actuator: one made for other parameters raises `InputError` unless
+        ``allow_mismatch=True``.
     """
 
     model = "lf"
@@ -77,22 +90,44 @@ class MonitorEma(_EmaModel):
         self,
         params: EmaParams | None = None,
         command: Command | None = None,
-        calibration: Calibration | None = None,
+        calibration: Calibration | str | os.PathLike[str] | None = None,
+        *,
+        allow_mismatch: bool = False,
     ) -> None:
         super().__init__(params, command)
-        self.calibration = calibration if calibration is not None else default_calibration()
+        self.calibration = resolve_calibration(calibration)
+        if not allow_mismatch:
+            where = (
+                "the packaged calibration"
+                if calibration is None
+                else f"calibration {calibration}"
+                if not isinstance(calibration, Calibration)
+                else "the calibration"
+            )
+            self.calibration.check_params(self.params, where=where)
 
     def rows(self, K: ArrayLike) -> NDArray[np.float64]:
         """Validated LF parameter rows for the fault rows K."""
         cal = self.calibration
         return monitor_rows(as_fault_matrix(K), self.params, [cal.coefficients], cal.n_lf)
 
-    def simulate_many(self, K: ArrayLike, *, duration: float | None = None) -> NDArray[np.float64]:
-        """i_q [A] of one run per fault row of K, shape (m, n_samples): one parallel kernel call."""
+    def simulate_many(
+        self, K: ArrayLike, *, duration: float | None = None, check: bool = True
+    ) -> NDArray[np.float64]:
+        """i_q [A] of one run per fault row of K, shape (m, n_samples): one parallel kernel call.
+
+        With `check`, a row that diverged (NaN or inf) raises `SimulationError`; without it the
+        caller handles such rows (identification ranks them last).
+        """
         _, theta_cmd = self.sample_grid(duration)
+        K = as_fault_matrix(K)
         rows = self.rows(K)
         out = np.empty((rows.shape[0], len(theta_cmd)))
         simulate_lf_many(theta_cmd, rows, out)
+        if check:
+            bad = ~np.all(np.isfinite(out), axis=1)
+            if bad.any():
+                check_finite(out[bad][:1], self.model, K[bad][0])
         return out
 
     def simulate(
@@ -111,6 +146,8 @@ class MonitorEma(_EmaModel):
         i_q = np.empty(len(t))
         aux = np.empty((len(t), N_AUX))
         simulate_lf(theta_cmd, self.rows(k)[0], i_q, aux)
+        check_finite(i_q, self.model, k)
+        check_finite(aux, self.model, k)
         col = {name: aux[:, j].copy() for j, name in enumerate(AUX_COLUMNS)}
         theta_u = col["theta_u"].copy()
         if noise:

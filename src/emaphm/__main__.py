@@ -1,0 +1,5 @@
+"""``python -m emaphm``: the command line."""
+
+from .cli import main
+
+main()

@@ -1,0 +1,183 @@
+"""The optimisers on cheap batch objectives: determinism, convergence, non-finite values, the early
+stop and the polish (as pymoo tests its own algorithms: small problems, small budgets, fixed seeds).
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from pymoo.algorithms.soo.nonconvex.ga import GA
+from pymoo.core.population import Population
+
+from emaphm import InputError
+from emaphm.identification.optimizers import (
+    OPTIMIZERS,
+    BatchProblem,
+    OptimizerRun,
+    Stagnation,
+    minimize_batch,
+    polish,
+    run_optimizer,
+)
+
+CENTRE = np.array([0.2, 0.7, 0.4, 0.1, 0.9, 0.5, 0.3, 0.6])
+BUDGET = {"pop_size": 20, "generations": 50}
+NO_EARLY_STOP = Stagnation(patience=1000)
+
+
+def bowl(X):
+    """A shifted quadratic bowl in 8-D: minimum 0 at CENTRE."""
+    return np.sum((X - CENTRE) ** 2, axis=1)
+
+
+def finite_region(X):
+    return (X[:, 0] <= 0.6) & (X[:, 1] >= 0.3) & (X[:, 2] <= 0.8)
+
+
+def bowl_with_holes(X):
+    """The bowl, but NaN, −inf or +inf outside `finite_region` (the minimum is inside it)."""
+    f = bowl(X)
+    f[X[:, 0] > 0.6] = np.nan
+    f[X[:, 1] < 0.3] = -np.inf  # would be the "best" value if it were ranked as it is
+    f[X[:, 2] > 0.8] = np.inf
+    return f
+
+
+@pytest.mark.parametrize("name", OPTIMIZERS)
+def test_same_seed_same_run_other_seed_differs(name):
+    a, b, c = (run_optimizer(name, bowl, **BUDGET, seed=s) for s in (3, 3, 4))
+    np.testing.assert_array_equal(a.x, b.x)
+    assert a.f == b.f and a.history == b.history and a.evaluations == b.evaluations
+    assert not np.array_equal(a.x, c.x) and a.history != c.history
+
+
+@pytest.mark.parametrize("name", OPTIMIZERS)
+def test_reaches_the_bottom_of_a_bowl(name):
+    # measured with pop 20 x 50, seed 1: f ≤ 1.2e-3 for all; over seeds 1..8 the worst was 1.7e-3
+    # (DE) and 2.8e-2 for the GWO (one seed stuck early), so the fixed seed 1 is checked
+    run = run_optimizer(name, bowl, **BUDGET, seed=1, stagnation=NO_EARLY_STOP)
+    assert run.f < 1e-2  # within 0.1 of the minimum
+    assert np.linalg.norm(run.x - CENTRE) < 0.1
+    assert run.f == pytest.approx(bowl(run.x[None, :])[0], rel=1e-12)
+    assert run.history[-1] == run.f and run.history == sorted(run.history, reverse=True)
+
+
+@pytest.mark.parametrize("name", OPTIMIZERS)
+def test_non_finite_values_never_win(name):
+    run = run_optimizer(name, bowl_with_holes, **BUDGET, seed=1, stagnation=NO_EARLY_STOP)
+    assert np.isfinite(run.f) and finite_region(run.x[None, :])[0]
+    assert run.f == bowl(run.x[None, :])[0]
+    assert run.f < 1e-2
+    assert np.isfinite(run.history[-1]) and not np.isnan(run.history).any()
+    polished = polish(bowl_with_holes, run, seed=1)
+    assert np.isfinite(polished.f) and finite_region(polished.x[None, :])[0]
+    assert polished.f <= run.f
+
+
+def test_batch_problem_maps_non_finite_to_inf_clips_and_counts():
+    seen = []
+
+    def evaluate(X):
+        seen.append(X.copy())
+        return np.array([np.nan, -np.inf, np.inf, 2.0])
+
+    problem = BatchProblem(evaluate, [0.0, -1.0], [1.0, 1.0])
+    X = np.array([[0.5, 0.0], [2.0, -3.0], [-1.0, 0.5], [0.25, 0.25]])
+    np.testing.assert_array_equal(problem.evaluate_batch(X), [np.inf, np.inf, np.inf, 2.0])
+    np.testing.assert_array_equal(seen[0], [[0.5, 0.0], [1.0, -1.0], [0.0, 0.5], [0.25, 0.25]])
+    assert problem.evaluations == 4
+    with pytest.raises(InputError, match="bounds"):
+        BatchProblem(evaluate, [0.0, 1.0], [1.0, 1.0])
+
+
+def test_batch_problem_on_other_bounds_as_in_the_calibration():
+    # a box that is not [0, 1]^n, with a NaN wall: the GA stays in the box and finds the minimum
+    xl, xu = np.array([-5.0, 10.0, 1e-4]), np.array([5.0, 30.0, 2e-4])
+    target = np.array([1.5, 12.0, 1.7e-4])
+    scale = xu - xl
+
+    def evaluate(X):
+        f = np.sum(((X - target) / scale) ** 2, axis=1)
+        return np.where(X[:, 0] > 4.0, np.nan, f)
+
+    problem = BatchProblem(evaluate, xl, xu)
+    calls = []
+    x, f, history = minimize_batch(
+        problem, GA(pop_size=20), 30, seed=2, on_generation=lambda *a: calls.append(a)
+    )
+    assert np.all((xl <= x) & (x <= xu)) and np.all(np.abs(x - target) / scale < 0.05)
+    assert f == evaluate(x[None, :])[0] and problem.evaluations >= 20 * 30 - 20
+    assert len(history) == 30 and [c[0] for c in calls] == list(range(1, 31))
+    assert all(c[1] == 30 for c in calls) and [c[2] for c in calls] == history
+
+
+def stops(values, patience=3, rtol=0.1, generations=100):
+    """Whether pymoo's termination from `Stagnation` says stop after each best value."""
+    termination = Stagnation(patience, rtol).termination(generations)
+    out = []
+    for gen, best in enumerate(values, start=1):
+        termination.update(SimpleNamespace(n_gen=gen, opt=Population.new("F", np.array([[best]]))))
+        out.append(termination.has_terminated())
+    return out
+
+
+def test_the_stopping_rule():
+    # `patience` generations in a row within rtol·|reference| of the reference best; inclusive
+    assert stops([10.0, 9.5, 9.2, 9.0]) == [False, False, False, True]
+    assert stops([-10.0, -10.5, -11.0, -11.0]) == [False, False, False, True]  # |reference|
+    # 8.9 improves on the reference 10 by more than 10 %: it is the new reference, 3 more to go
+    assert stops([10.0, 9.5, 9.2, 8.9, 8.5, 8.3, 8.3]) == [False] * 6 + [True]
+    # a non-finite best never counts as stagnant
+    assert stops([np.inf] * 4 + [5.0] * 4) == [False] * 7 + [True]
+    assert stops([10.0, 5.0, 2.0], generations=3) == [False, False, True]  # the budget
+    with pytest.raises(InputError, match="patience"):
+        Stagnation(patience=0)
+    with pytest.raises(InputError, match="rtol"):
+        Stagnation(rtol=np.nan)
+
+
+@pytest.mark.parametrize("name", OPTIMIZERS)
+def test_stops_early_on_a_flat_objective(name):
+    # relative changes of at most 1e-6: stagnant from the start; the first stop is at patience + 1
+    def nearly_flat(X):
+        return 1.0 + 1e-6 * bowl(X)
+
+    reported = []
+    run = run_optimizer(
+        name, nearly_flat, pop_size=16, generations=100, seed=1, stagnation=Stagnation(patience=10),
+        on_generation=lambda gen, total, best: reported.append((gen, total, best)),
+    )  # fmt: skip
+    assert len(run.history) == 11
+    assert reported == [(g + 1, 100, best) for g, best in enumerate(run.history)]
+
+
+@pytest.mark.parametrize("name", OPTIMIZERS)
+def test_runs_to_the_budget_while_improving(name):
+    # every batch is 10 % better than the one before, whatever the points: never stagnant
+    calls = [0]
+
+    def improving(X):
+        calls[0] += 1
+        return 0.9 ** calls[0] * (1.0 + bowl(X))
+
+    run = run_optimizer(
+        name, improving, pop_size=16, generations=30, seed=1, stagnation=Stagnation(patience=5)
+    )
+    assert len(run.history) == 30
+
+
+def test_the_polish_never_returns_a_worse_point():
+    rng = np.random.default_rng(0)
+    starts = [OptimizerRun(x, float(bowl(x[None, :])[0]), 0, [0.0]) for x in rng.uniform(0, 1, (2, 8))]
+    starts.append(OptimizerRun(CENTRE.copy(), 0.0, 0, [0.0]))  # at the minimum already
+    for start in starts:
+        run = polish(bowl, start, seed=1)
+        assert run.f <= start.f and run.f == bowl(run.x[None, :])[0]
+        assert run.evaluations > start.evaluations and run.history[:1] == start.history
+    # a start better than anything the polish can find (e.g. from a lower-valued measurement)
+    start = OptimizerRun(CENTRE + 0.05, -1.0, 7, [-1.0])
+    run = polish(bowl, start, seed=1)
+    assert run.f == -1.0 and np.array_equal(run.x, start.x) and run.evaluations > 7
+    # and it improves a start away from the minimum
+    away = starts[0]
+    assert polish(bowl, away, seed=1).f < 1e-2 * away.f
