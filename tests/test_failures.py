@@ -299,3 +299,23 @@ def test_a_non_finite_history_entry_is_written_as_valid_json():
     )  # fmt: skip
     text = json.dumps(r.to_json(), allow_nan=False)  # raises on Infinity / NaN
     assert json.loads(text)["history"] == [None, 2.0, 1.0]
+
+
+def test_a_renamed_copy_of_the_package_gets_cache_entries_of_its_own():
+    # numba's index records types by module name: a copy imported as another package, with the
+    # same kernel sources, must not read or write this package's entries
+    from emaphm.kernels import _jit
+
+    def ours():  # pragma: no cover - only its metadata is read
+        pass
+
+    def theirs():  # pragma: no cover
+        pass
+
+    ours.__module__ = "emaphm.kernels.hf_twin"
+    theirs.__module__ = "emaphm_copy.kernels.hf_twin"
+    kernel_file = str(_jit.KERNEL_DIR / "hf_twin.py")
+    a = _jit.KernelCacheLocator.from_function(ours, kernel_file).get_cache_path()
+    b = _jit.KernelCacheLocator.from_function(theirs, kernel_file).get_cache_path()
+    assert a != b and a.endswith("emaphm") and b.endswith("emaphm_copy")
+    assert _jit.KernelCacheLocator.from_function(ours, __file__) is None  # not a kernel file

@@ -6,8 +6,10 @@ old machine code (numba issues #8396, #9563). emaphm's kernels therefore use the
 locator: the cache folder and every function's source stamp are keyed by one hash of *all*
 kernel sources (`KERNEL_SOURCE_HASH`), so any edit to any kernel file recompiles every kernel.
 
-The cache lives in ``$NUMBA_CACHE_DIR/emaphm-kernels-<hash>`` when the user set
-``NUMBA_CACHE_DIR``, else in ``$XDG_CACHE_HOME/emaphm/numba-<hash>`` (``~/.cache/...``). When
+The cache lives in ``$NUMBA_CACHE_DIR/emaphm-kernels-<hash>/<package>`` when the user set
+``NUMBA_CACHE_DIR``, else in ``$XDG_CACHE_HOME/emaphm/numba-<hash>/<package>`` (``~/.cache/...``);
+<package> is the importing package's name (numba's index records types by module name, so a
+renamed copy of the package must not read this one's entries). When
 no such folder can be written, the kernels compile in memory on every run (slower start, never
 stale).
 """
@@ -64,7 +66,10 @@ class KernelCacheLocator(caching._CacheLocator):  # type: ignore[misc]
 
     def __init__(self, py_func: Any, py_file: str) -> None:
         self._lineno = py_func.__code__.co_firstlineno
-        self._cache_path = str(kernel_cache_dir())
+        # one sub-folder per importing package name: numba's index records types by module
+        # name, so a renamed copy of the package (same sources) must not share its entries
+        package = str(getattr(py_func, "__module__", "") or "").split(".", 1)[0] or "unknown"
+        self._cache_path = str(kernel_cache_dir() / package)
 
     def get_cache_path(self) -> str:
         return self._cache_path
@@ -90,7 +95,7 @@ _CACHE_IMPL: Any = getattr(caching, "CacheImpl", None) or getattr(caching, "_Cac
 if KernelCacheLocator not in _CACHE_IMPL._locator_classes:
     _CACHE_IMPL._locator_classes.insert(0, KernelCacheLocator)
 
-CACHE_ENABLED = _writable(kernel_cache_dir())
+CACHE_ENABLED = _writable(kernel_cache_dir() / __name__.split(".", 1)[0])
 
 
 def jit(fn: F | None = None, *, parallel: bool = False) -> Any:
