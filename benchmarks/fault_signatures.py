@@ -5,7 +5,8 @@
 Part 1, the FDI chirp, noise off: change of the filtered i_q (2nd-order Butterworth, 150 Hz,
 zero phase) in % of the healthy RMS; the chaotic floor (friction changed by 1e-5) and the noise
 floor (noise on, seed 1) for scale. Part 2, a constant-speed ramp (0.1 rad/s): amplitude and phase of
-the 1θ_e and 2θ_e components of i_q, fitted after 0.2 s.
+the 1θ_e and 2θ_e components of i_q, fitted after 0.2 s, and how far the eccentricity's 1θ_e
+component turns when φ_e turns by 90° (k7 0 → 0.25).
 """
 
 from __future__ import annotations
@@ -53,13 +54,17 @@ def main() -> None:
 
     print("Part 2: ramp 0.1 rad/s, harmonics of i_q (amplitude mA, phase deg)")
     ramp = emaphm.Ramp(rate=0.1, t_0=0.0, duration=0.6)
+    phase_1 = {}
     for name, vec in {
         "healthy": emaphm.HEALTHY, "short A k3=0.3": k(k3=0.3), "short B k4=0.3": k(k4=0.3),
         "short C k5=0.3": k(k5=0.3), "ecc k6=0.3 k7=0": k(k6=0.3), "ecc k6=0.3 k7=0.25": k(k6=0.3, k7=0.25),
     }.items():  # fmt: skip
         r = emaphm.simulate(vec, noise=False, command=ramp)
         (a1, p1), (a2, p2) = harmonic(r, 1), harmonic(r, 2)
+        phase_1[name] = p1
         print(f"  {name:<20} 1θ_e {1e3 * a1:6.2f} mA {p1:7.1f}°   2θ_e {1e3 * a2:6.2f} mA {p2:7.1f}°")
+    turn = (phase_1["ecc k6=0.3 k7=0.25"] - phase_1["ecc k6=0.3 k7=0"] + 180.0) % 360.0 - 180.0
+    print(f"  eccentricity 1θ_e component turns by {turn:.1f}° when φ_e turns by 90°")
 
 
 if __name__ == "__main__":

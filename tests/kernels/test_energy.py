@@ -16,6 +16,11 @@ mechanics), which differ from those by −(Δt/2)·Σ (R_x·ī_x + e_x)·Δi_x p
 by B = (Δt/2)·Σ (R_x·|ī_x| + |e_x|)·|Δi_x|, is the integration error the balance is held to
 (|Δi_x| ≈ V_dc·Δt/L_x per step: B shrinks with Δt). Here B is 0.05–0.5 % of E_in, and a torque or
 back-EMF coupling off by 2 % moves the balance by more than 2·B.
+
+The back-EMF is written here from the documented physics, independent of the kernel (DESIGN §3.7):
+e_x = ω_m·∂ψ_x/∂θ_m of the magnet flux linkage ψ_x = N_x·ψ_m·[1 − ζ·cos(θ_e + φ_e)]·cos(θ_e − γ_x),
+and the kernel's torque must be the co-energy torque Σ_x i_x·∂ψ_x/∂θ_m, so that T_m·ω_m = Σ_x e_x·i_x
+at every step (with the currents the torque is formed from, those at the end of the step).
 """
 
 import numpy as np
@@ -43,9 +48,14 @@ def run(N, zeta, omega, i_q_ref, t_end=20e-3, dt=1e-6, h=0.1):
 
     R = np.array([sp.R_a, sp.R_b, sp.R_c])
     L = np.array([sp.L_a, sp.L_b, sp.L_c])
-    # the documented physics, independent of the kernel: e_x = k_e,x·[1 − ζ·cos(θ_e + φ_e)]·ω_m·u_x
-    u = -np.sin(theta_e[:, None] - GAMMA)
-    e = np.array([sp.k_e_a, sp.k_e_b, sp.k_e_c]) * (1 - zeta * np.cos(theta_e + PHI_E))[:, None] * omega * u
+    # the documented physics, independent of the kernel: e_x = ω_m·∂ψ_x/∂θ_m (module docstring),
+    # ∂ψ_x/∂θ_m = k_e,x·{[1 − ζ·cos(θ_e + φ_e)]·u_x + ζ·sin(θ_e + φ_e)·cos(θ_e − γ_x)}
+    th = theta_e[:, None]
+    u = -np.sin(th - GAMMA)
+    dpsi = np.array([sp.k_e_a, sp.k_e_b, sp.k_e_c]) * (
+        (1 - zeta * np.cos(th + PHI_E)) * u + zeta * np.sin(th + PHI_E) * np.cos(th - GAMMA)
+    )
+    e = dpsi * omega
     v_x0 = s * V_dc / 2  # comparator state of the step → leg voltage
     i_k, i_k1 = i[:-1], i[1:]
     i_mid = 0.5 * (i_k + i_k1)
@@ -61,6 +71,10 @@ def run(N, zeta, omega, i_q_ref, t_end=20e-3, dt=1e-6, h=0.1):
         E_R_k=dt * np.sum(R * i_k * i_mid),
         E_e=dt * np.sum(e * i_mid),
         switches=np.sum(np.abs(np.diff(s, axis=0))) / 2,
+        # per step: T_m·ω_m against the power into the back-EMFs, Σ_x e_x·i_x (currents at the end
+        # of the step, as T_m), and the scale of either term
+        P_err=np.max(np.abs(T * omega - np.sum(e * i_k1, axis=1))),
+        P_scale=np.max(np.abs(e)) * np.max(np.abs(i)),
     )
 
 
@@ -71,9 +85,11 @@ def run(N, zeta, omega, i_q_ref, t_end=20e-3, dt=1e-6, h=0.1):
         ((0.5, 1.0, 1.0), 0.0, 0.0, 2.0),  # locked rotor, phase A half shorted
         ((1.0, 1.0, 1.0), 0.0, 30.0, 2.0),  # slowly turning (≈ 19 Hz electrical), motoring
         ((0.5, 1.0, 1.0), 0.2, 30.0, 2.0),  # shorted phase and eccentricity
+        ((1.0, 1.0, 1.0), 0.3, 30.0, 2.0),  # eccentricity alone
+        ((1.0, 0.8, 1.0), 0.3, 60.0, -3.0),  # eccentricity, braking
         ((1.0, 0.7, 1.0), 0.0, 60.0, -3.0),  # braking: the inverter takes energy back
     ],
-    ids=["locked", "locked-short", "turning", "turning-short-ecc", "braking"],
+    ids=["locked", "locked-short", "turning", "turning-short-ecc", "turning-ecc", "braking-ecc", "braking"],
 )
 def test_energy_balance_within_integration_error(N, zeta, omega, i_q_ref):
     r = run(N, zeta, omega, i_q_ref)
@@ -84,6 +100,8 @@ def test_energy_balance_within_integration_error(N, zeta, omega, i_q_ref):
     assert r["B"] <= 5e-3 * abs(r["E_in"])
     # the per-step identity holds to rounding (energy scale 0.1 J, relative 1e-12)
     assert abs(r["E_in"] - (r["E_R_k"] + r["dE_L"] + r["E_e"])) <= 1e-12 * abs(r["E_in"])
+    # the torque is the co-energy torque: T_m·ω_m = Σ_x e_x·i_x at every step, to rounding
+    assert r["P_err"] <= 1e-12 * r["P_scale"]
     if omega != 0.0:
         # the balance resolves the coupling: 2 % more torque (or back-EMF) is outside it
         assert 0.02 * abs(r["E_mech"]) > 2 * r["B"]

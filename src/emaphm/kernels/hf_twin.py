@@ -24,9 +24,11 @@ results differ by rounding only):
     with its coefficients and the other run constants (reciprocals instead of divisions) computed
     once; the isolated neutral keeps i_a + i_b + i_c = 0 (DESIGN §3.4), so the loop carries i_a
     and i_b and takes i_c = −(i_a + i_b);
-  * the back-EMF term β and the torque coefficients are linear forms in (sin θ_e, cos θ_e) with
-    run-constant coefficients, times ecc; the part of the speed update that does not depend on
-    the torque is formed before it;
+  * the back-EMF term β and the torque coefficients are linear forms in (sin θ_e, cos θ_e,
+    sin 2θ_e, cos 2θ_e) with run-constant coefficients (the coupling k_e,x·[u_x +
+    ζ·sin(2θ_e + φ_e − γ_x)] of `pmsm_abc`, DESIGN §3.7); the 2θ_e part, a few ns per step, is
+    skipped when ζ = 0, where its coefficients are exact zeros; the part of the speed update that
+    does not depend on the torque is formed before it;
   * the comparators branch on their state (a leg can only switch away from the side it is on),
     and V·s is recomputed only when a leg switches;
   * with n_sub = 1 (healthy) the sub-step runs without a loop.
@@ -113,15 +115,13 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_p
     p = sp.p
     p_dt = p * dt  # θ_e advances by p·Δt·ω_m per step
     half_h = 0.5 * sp.h
-    zeta_cos = sp.zeta_cos
-    zeta_sin = sp.zeta_sin
     inv_sub = 1.0 / n_sub
     inv_per = 1.0 / n_per_sample
     # one Euler sub-step of the stator, i ← i + D·i + V·s + β (pmsm_abc.euler_map, DESIGN
     # §3.4–§3.7). The isolated neutral keeps i_c = −(i_a + i_b) (every column of M sums to zero),
     # so the loop carries i_a and i_b only: i_x ← A_xa·i_a + A_xb·i_b + V_x·s + β_x for x = a, b,
     # with A_xy = δ_xy + D_xy − D_xc.
-    D, V, S, C = euler_map(sp, dt / n_sub)
+    D, V, S, C, S2, C2 = euler_map(sp, dt / n_sub)
     A_aa = 1.0 + (D[0][0] - D[0][2])
     A_ab = D[0][1] - D[0][2]
     A_ba = D[1][0] - D[1][2]
@@ -130,11 +130,20 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_p
     V_ba, V_bb, V_bc = V[1]
     S_a, S_b = S[0], S[1]
     C_a, C_b = C[0], C[1]
-    # k_e,x·u_x − k_e,c·u_c = q_sin_x·sin θ_e + q_cos_x·cos θ_e (u_x: transforms.phase_directions)
+    S2_a, S2_b = S2[0], S2[1]
+    C2_a, C2_b = C2[0], C2[1]
+    # g_x − g_c = q_sin_x·sin θ_e + q_cos_x·cos θ_e + q2_sin_x·sin 2θ_e + q2_cos_x·cos 2θ_e with the
+    # coupling g_x = k_e,x·[u_x + ζ·sin(2θ_e + φ_e − γ_x)] (pmsm_abc, DESIGN §3.7; u_x:
+    # transforms.phase_directions, ζ·sin(2θ_e + φ_e − γ_x) = ecc2_sin_x·sin 2θ_e + ecc2_cos_x·cos 2θ_e)
     q_sin_a = -sp.k_e_a - 0.5 * sp.k_e_c
     q_cos_a = HALF_SQRT3 * sp.k_e_c
     q_sin_b = 0.5 * (sp.k_e_b - sp.k_e_c)
     q_cos_b = HALF_SQRT3 * (sp.k_e_b + sp.k_e_c)
+    q2_sin_a = sp.k_e_a * sp.ecc2_sin_a - sp.k_e_c * sp.ecc2_sin_c
+    q2_cos_a = sp.k_e_a * sp.ecc2_cos_a - sp.k_e_c * sp.ecc2_cos_c
+    q2_sin_b = sp.k_e_b * sp.ecc2_sin_b - sp.k_e_c * sp.ecc2_sin_c
+    q2_cos_b = sp.k_e_b * sp.ecc2_cos_b - sp.k_e_c * sp.ecc2_cos_c
+    eccentric = sp.zeta != 0.0  # else every 2θ_e coefficient is an exact zero: skip them
     # mechanics (DESIGN §3.8, mechanics.mechanics_step)
     T_load_m = mp.T_load / (mp.tau * mp.eta)  # load reflected through the gear
     dt_J = dt / mp.J
@@ -200,15 +209,20 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_p
             u_a = -sin_e  # u_x = −sin(θ_e − γ_x), transforms.phase_directions
             u_b = 0.5 * sin_e + HALF_SQRT3 * cos_e
             u_c = 0.5 * sin_e - HALF_SQRT3 * cos_e
-            # DESIGN §3.7: eccentricity modulates the coupling of every phase
-            ecc = 1.0 - (cos_e * zeta_cos - sin_e * zeta_sin)
-            # β = −h·M·e, e_x = k_e,x·ecc·ω_m·u_x (DESIGN §3.5), folded by euler_map into S, C
-            be_a = ecc * ((omega_m * S_a) * sin_e + (omega_m * C_a) * cos_e)
-            be_b = ecc * ((omega_m * S_b) * sin_e + (omega_m * C_b) * cos_e)
-            # T_m = Σ_x k_e,x(θ)·u_x·i_x (DESIGN §3.5) = g_ac·i_a + g_bc·i_b with i_c = −(i_a + i_b),
-            # g_xc = ecc·(k_e,x·u_x − k_e,c·u_c), a linear form in (sin θ_e, cos θ_e) times ecc
-            g_ac = ecc * (q_sin_a * sin_e + q_cos_a * cos_e)
-            g_bc = ecc * (q_sin_b * sin_e + q_cos_b * cos_e)
+            # β = −h·M·e, e_x = g_x·ω_m (DESIGN §3.5), folded by euler_map into S, C, S2, C2
+            be_a = (omega_m * S_a) * sin_e + (omega_m * C_a) * cos_e
+            be_b = (omega_m * S_b) * sin_e + (omega_m * C_b) * cos_e
+            # T_m = Σ_x g_x·i_x (DESIGN §3.5) = g_ac·i_a + g_bc·i_b with i_c = −(i_a + i_b)
+            g_ac = q_sin_a * sin_e + q_cos_a * cos_e
+            g_bc = q_sin_b * sin_e + q_cos_b * cos_e
+            if eccentric:
+                # DESIGN §3.7: the eccentric flux linkage adds the 2θ_e harmonic to every coupling
+                sin_2e = (sin_e + sin_e) * cos_e
+                cos_2e = (cos_e - sin_e) * (cos_e + sin_e)
+                be_a += (omega_m * S2_a) * sin_2e + (omega_m * C2_a) * cos_2e
+                be_b += (omega_m * S2_b) * sin_2e + (omega_m * C2_b) * cos_2e
+                g_ac += q2_sin_a * sin_2e + q2_cos_a * cos_2e
+                g_bc += q2_sin_b * sin_2e + q2_cos_b * cos_2e
             w_a = -sin_e + INV_SQRT3 * cos_e  # i_q = −i_α·sin θ_e + i_β·cos θ_e
             w_b = 2.0 * INV_SQRT3 * cos_e
             lo_a = i_q_ref * u_a - half_h  # DESIGN §3.3: band i_x,ref ± h/2
