@@ -10,15 +10,26 @@ time shift between the signals would produce a large residual; the weight 1/sqrt
 discounts exactly those samples, which makes the fitness tolerant to small phase lags. A slope
 unit of A/ms can be chosen (`slope_unit="ms"`): the weights are then ≈ 1 and err is plain least
 squares.
+
+A population of monitor-model rows is scored by `Fitness.of_monitor`: one parallel kernel call
+(`kernels.fitness.fitness_lf_many`) simulates, filters and sums each row, giving the same numbers
+as ``fitness(monitor.simulate_many(K, check=False))`` without the serial filter and sum.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.signal import butter, sosfilt_zi
 
 from ..errors import InputError
-from .signals import Comparison
+from ..kernels.fitness import fitness_lf_many
+from .signals import CUTOFF_HZ, FILTER_ORDER, Comparison
+
+if TYPE_CHECKING:
+    from ..models import MonitorEma
 
 __all__ = ["SLOPE_UNITS", "Fitness"]
 
@@ -35,7 +46,38 @@ class Fitness:
         self.slope_unit = slope_unit
         slope = np.gradient(reference.reference, reference.t) * SLOPE_UNITS[slope_unit]
         self.weights: NDArray[np.float64] = 1.0 / np.sqrt(slope**2 + 1.0)
+        # the comparison filter (`signals.lowpass`) for the fused kernel: sosfiltfilt's defaults
+        self.sos: NDArray[np.float64] = butter(FILTER_ORDER, CUTOFF_HZ, fs=reference.f_s, output="sos")
+        self.zi: NDArray[np.float64] = sosfilt_zi(self.sos)
+        self.padlen = sosfiltfilt_padlen(self.sos)
 
     def __call__(self, currents: ArrayLike) -> NDArray[np.float64]:
         residual = self.reference.reference - self.reference.filtered(currents)
         return np.sum(self.weights * residual**2, axis=-1)  # type: ignore[no-any-return]
+
+    def of_monitor(
+        self, monitor: MonitorEma, K: ArrayLike, *, duration: float | None = None
+    ) -> NDArray[np.float64]:
+        """eq. (3) of the monitor model's current for each fault row of K, shape (m,): one parallel
+        kernel call (simulation, filter and weighted sum fused per row).
+
+        Equal to ``self(monitor.simulate_many(K, duration=duration, check=False))`` (the same
+        operations in the same order); a row that diverged gets NaN. The monitor's sample grid
+        over `duration` must be the reference's.
+        """
+        _, theta_cmd = monitor.sample_grid(duration)
+        rows = monitor.rows(K)
+        ref = self.reference.reference
+        if len(theta_cmd) != len(ref):
+            raise ValueError(f"the monitor's grid has {len(theta_cmd)} samples, the reference {len(ref)}")
+        if len(ref) <= self.padlen:
+            raise ValueError(f"the filter needs more than {self.padlen} samples, got {len(ref)}")
+        out = np.empty(rows.shape[0])
+        fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out)
+        return out
+
+
+def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
+    """The edge `scipy.signal.sosfiltfilt` pads by default: 3·ntaps (9 for one biquad)."""
+    ntaps = 2 * sos.shape[0] + 1 - min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
+    return 3 * ntaps

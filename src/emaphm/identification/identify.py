@@ -36,8 +36,9 @@ from .signals import Comparison
 __all__ = ["MIN_SAMPLES", "FaultIdentifier", "IdentificationResult", "identify", "search_to_faults"]
 
 MIN_SAMPLES = 200  # a reference shorter than this (20 ms at 10 kHz) cannot show the faults
-# the comparison spans at most this: a population holds pop_size x samples currents (96 x 1e6 x 8 B
-# = 0.8 GB at 100 s), and a longer span is more often a time axis in ms than a real recording
+# the comparison spans at most this: 100 s is 1e6 samples per row (the fused fitness kernel keeps
+# two rows per thread; the reference, its weights and the grid are a few times that), and a longer
+# span is more often a time axis in ms than a real recording
 MAX_SPAN = 100.0
 
 
@@ -162,8 +163,9 @@ class FaultIdentifier:
         fitness = Fitness(reference, self.slope_unit)
 
         def evaluate(X: NDArray[np.float64]) -> NDArray[np.float64]:
-            # a diverged row gets a non-finite fitness, which the optimisers rank last
-            return fitness(monitor.simulate_many(search_to_faults(X), duration=duration, check=False))
+            # one parallel kernel call: simulation, filter and eq. (3) fused per row, the same numbers
+            # as fitness(monitor.simulate_many(...)); a diverged row gets NaN, which the optimisers rank last
+            return fitness.of_monitor(monitor, search_to_faults(X), duration=duration)
 
         start = time.perf_counter()
         run: OptimizerRun = run_optimizer(

@@ -338,13 +338,15 @@ def polish(
     sigma: float = 0.05,
     stagnation: Stagnation | None = None,
     on_generation: OnGeneration | None = None,
+    budget: tuple[int, int] | None = None,
 ) -> OptimizerRun:
     """Refine a run's best point with a small CMA-ES around it (step `sigma` in the unit box).
 
-    Budget `POLISH_BUDGET`; stops early by `stagnation` (default `Stagnation(patience=15)`).
-    Keeps the start point if the polish finds nothing better; the history continues the start's.
+    `budget` (population, generations) defaults to `POLISH_BUDGET`; stops early by `stagnation`
+    (default `Stagnation(patience=15)`). Keeps the start point if the polish finds nothing
+    better; the history continues the start's.
     """
-    pop_size, generations = POLISH_BUDGET
+    pop_size, generations = POLISH_BUDGET if budget is None else budget
     stop = stagnation if stagnation is not None else Stagnation(patience=15)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     x, f, history = minimize_batch(
