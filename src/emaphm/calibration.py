@@ -148,6 +148,19 @@ class Calibration:
         params = self.record.get("settings", {}).get("params")
         return params if isinstance(params, dict) else None
 
+    def command(self) -> Any:
+        """The position command the calibration was fitted under (None if not recorded or sampled)."""
+        from .commands import make_command
+
+        rec = dict(self.record.get("settings", {}).get("command") or {})
+        kind = rec.pop("type", None)
+        if kind is None or kind == "sampled":
+            return None
+        try:
+            return make_command(kind, **rec)
+        except InputError:
+            return None
+
     @property
     def params_hash(self) -> str | None:
         """Digest of the recorded parameters (`params_hash`), None for an unbound calibration."""

@@ -155,6 +155,8 @@ def identify(
             on_generation=lambda gen, total, best: update(f"{optimizer.upper()} generations", gen, total),
         )  # fmt: skip
     data = result.to_json()
+    for warning in data["warnings"]:
+        err.print(f"emaphm: warning: {warning}", soft_wrap=True)
     if output is not None:
         with atomic_path(output) as tmp:
             tmp.write_text(json.dumps(data, indent=2) + "\n")

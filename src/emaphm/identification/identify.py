@@ -27,6 +27,7 @@ from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
 from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..results import SimResult
+from .coverage import command_warnings
 from .detection import detect
 from .fitness import Fitness
 from .metrics import absolute_errors, percent_error
@@ -57,6 +58,7 @@ class IdentificationResult:
     history: list[float] = field(default_factory=list)
     settings: dict[str, Any] = field(default_factory=dict)
     version: str = __version__
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def percent_error(self) -> float | None:
@@ -79,6 +81,7 @@ class IdentificationResult:
             "seed": self.seed,
             "optimizer": self.optimizer,
             "version": self.version,
+            "warnings": self.warnings,
             "settings": self.settings,
             # a generation whose best row diverged has no finite best: null, so the JSON stays valid
             "history": [float(v) if np.isfinite(v) else None for v in self.history],
@@ -245,6 +248,7 @@ def identify(
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command)
     run = ident.run_
+    warnings = command_warnings(trace.t, trace.theta_cmd, monitor.calibration)
     settings = {
         "reference": source,
         "noise_seed": noise_seed if true_faults is not None else None,
@@ -271,4 +275,5 @@ def identify(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=run.evaluations,
         wall_time_s=round(time.perf_counter() - start, 3), seed=seed, optimizer=optimizer, truth=truth,
         detected=detect(ident.faults_, thresholds), history=run.history, settings=settings,
+        warnings=warnings,
     )  # fmt: skip

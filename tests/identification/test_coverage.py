@@ -1,0 +1,69 @@
+"""A trace recorded under another command than the calibrated one is flagged (issue 8, item 5)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+import emaphm
+from emaphm.calibration import default_calibration
+from emaphm.commands import Chirp, Step
+from emaphm.identification.coverage import command_warnings
+from tests.helpers import run_cli
+
+CAL = default_calibration()
+
+
+def test_the_calibrated_chirp_raises_no_warning_at_any_sample_rate():
+    for f_s in (10_000.0, 3_000.0, 64_000.0):
+        t = np.arange(int(1.0 * f_s) + 1) / f_s + 12.3  # a logger's clock offset
+        assert command_warnings(t, Chirp()(t - t[0]), CAL) == []
+
+
+def test_a_longer_trace_is_flagged():
+    t = np.arange(20001) / 1e4
+    reasons = command_warnings(t, Chirp(T=2.0)(t), CAL)
+    assert any("runs 2 s" in r for r in reasons)
+    # the chirp followed by a hold: the first second matches, the rest is beyond the calibration
+    held = np.where(t <= 1.0, Chirp()(np.minimum(t, 1.0)), Chirp()(np.array([1.0]))[0])
+    reasons = command_warnings(t, held, CAL)
+    assert len(reasons) == 1 and "runs 2 s" in reasons[0]
+
+
+def test_another_command_is_flagged_and_a_tiny_difference_is_not():
+    t = np.arange(5001) / 1e4
+    assert any("differs" in r for r in command_warnings(t, Step()(t), CAL))
+    chirp = Chirp()(t)
+    assert command_warnings(t, chirp + 1e-6, CAL) == []  # ADC-level noise on a logged command
+    assert any("differs" in r for r in command_warnings(t, 1.1 * chirp, CAL))
+
+
+def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_path, capsys):
+    trace = emaphm.simulate(emaphm.HEALTHY, model="lf", command=Step(), noise=False)
+    r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
+    assert r.warnings and "differs" in r.warnings[0]
+    assert r.to_json()["warnings"] == r.warnings
+    path = tmp_path / "step.h5"
+    emaphm.write_trace(trace, path)
+    code, out, err = run_cli(
+        [
+            "identify",
+            "--reference",
+            str(path),
+            "--pop-size",
+            "8",
+            "--generations",
+            "1",
+            "--no-polish",
+            "--json",
+        ],
+        capsys,
+    )
+    assert code == 0 and "emaphm: warning: the position command differs" in err
+    assert json.loads(out)["warnings"] == r.warnings
+
+
+def test_the_twin_on_the_fdi_chirp_raises_no_warning():
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False)
+    assert r.warnings == []
