@@ -1,7 +1,8 @@
 """The ``emaphm`` command line: argument parsing and printing only (DESIGN §8).
 
 Exit status: 0 success, 2 bad input or usage (one-line reason on stderr), 1 failure (one line
-too: a diverged simulation, a file system error), 130 interrupted (Ctrl-C). Every check of the
+too: a diverged simulation, a file system error), 3 `identify` ran but the monitor cannot explain
+the recording (verdict "does not fit", no faults reported), 130 interrupted (Ctrl-C). Every check of the
 input, output paths included, runs before the work, and no output is ever left half-written.
 
 Only light modules are imported at start (`emaphm --version` and `--help` answer at once); each
@@ -162,8 +163,10 @@ def identify(
             tmp.write_text(json.dumps(data, indent=2) + "\n")
     if json_out:
         typer.echo(json.dumps(data))
-        return
-    _print_identification(data)
+    else:
+        _print_identification(data)
+    if data["verdict"] != "fits":
+        raise typer.Exit(3)  # ran, but no diagnosis: scripts must not read it as one
 
 
 def _print_identification(data: dict[str, Any]) -> None:
@@ -180,7 +183,10 @@ def _print_identification(data: dict[str, Any]) -> None:
     out.print(table)
     if data["percent_error"] is not None:
         out.print(f"%err {data['percent_error']:.2f}")
-    out.print(f"detected: {', '.join(data['detected']) or 'none (healthy)'}")
+    if data["verdict"] != "fits":
+        out.print("verdict: does not fit (see the warning): no faults reported")
+    else:
+        out.print(f"detected: {', '.join(data['detected']) or 'none (healthy)'}")
     out.print(
         f"fitness {data['fitness']:.4g}, {data['evaluations']} evaluations, {data['wall_time_s']:.1f} s"
     )

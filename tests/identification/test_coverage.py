@@ -51,6 +51,8 @@ def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_
             "identify",
             "--reference",
             str(path),
+            "--seed",
+            "1",
             "--pop-size",
             "8",
             "--generations",
@@ -60,10 +62,12 @@ def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_
         ],
         capsys,
     )
-    assert code == 0 and "emaphm: warning: the position command differs" in err
-    assert json.loads(out)["warnings"] == r.warnings
+    data = json.loads(out)
+    assert "emaphm: warning: the position command differs" in err
+    assert data["warnings"] == r.warnings
+    assert code == (0 if data["verdict"] == "fits" else 3)  # exit 3: ran, but no diagnosis
 
 
 def test_the_twin_on_the_fdi_chirp_raises_no_warning():
-    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False)
-    assert r.warnings == []
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=16, generations=3, local_polish=False)
+    assert r.verdict == "fits" and r.warnings == []
