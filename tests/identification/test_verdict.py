@@ -52,3 +52,11 @@ def test_the_command_line_exits_3_on_does_not_fit(measured, tmp_path, capsys):
     assert "cannot explain" in err
     code, out, _ = run_cli(args, capsys)
     assert code == 3 and "verdict: does not fit" in out and "detected:" not in out
+
+
+def test_a_recording_too_short_for_a_diagnosis_is_refused(measured):
+    # 300 samples (30 ms) fit the monitor to a few % NRMSE and "detected" every fault
+    n = 300
+    short = SimResult(t=measured.t[:n], signals={k: v[:n] for k, v in measured.signals.items()})
+    with pytest.raises(emaphm.InputError, match=r"at least 0\.2 s"):
+        emaphm.identify(reference=short, seed=1)
