@@ -86,17 +86,12 @@ def simulate(
     from .commands import make_command
     from .faults import describe, parse_faults
     from .io import TRACE_SUFFIXES, check_output_path, write_trace
-    from .models import HighFidelityEma, MonitorEma, check_seed
+    from .models import check_seed, make_model
 
     k = parse_faults(faults)
     check_seed(seed)
     check_output_path(output, suffixes=TRACE_SUFFIXES, inputs=(calibration,))  # before the work
-    if model not in ("hf", "lf"):
-        raise InputError(f"unknown model {model!r}; available: hf, lf")
-    if calibration is not None and model != "lf":
-        raise InputError("--calibration applies to the monitor model only (--model lf)")
-    cmd = make_command(command)
-    ema = HighFidelityEma(command=cmd) if model == "hf" else MonitorEma(command=cmd, calibration=calibration)
+    ema = make_model(model, command=make_command(command), calibration=calibration)
     ema.sample_grid(duration)  # a duration no run can have: before the work
     with _status(f"simulating {model.upper()} twin ({describe(k)})"):
         result = ema.simulate(k, noise=noise, seed=seed, duration=duration)

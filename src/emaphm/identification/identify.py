@@ -60,6 +60,11 @@ MAX_SPAN = 100.0
 FIT_NRMSE_LIMIT = 0.5
 
 
+def explains(fit_nrmse: float | None) -> bool:
+    """Whether a fit's NRMSE (`FIT_NRMSE_LIMIT`) makes it a diagnosis; None (not measured) does."""
+    return fit_nrmse is None or fit_nrmse <= FIT_NRMSE_LIMIT
+
+
 @dataclass(frozen=True)
 class IdentificationResult:
     """One identification: the estimate and everything needed to reproduce and judge it."""
@@ -82,7 +87,7 @@ class IdentificationResult:
     def fits(self) -> bool:
         """True when the monitor explains the measurement (`FIT_NRMSE_LIMIT`); else no faults are
         reported: a result the model cannot explain is not a diagnosis."""
-        return self.fit_nrmse is None or self.fit_nrmse <= FIT_NRMSE_LIMIT
+        return explains(self.fit_nrmse)
 
     @property
     def verdict(self) -> str:
@@ -293,7 +298,7 @@ def identify(
         ident.fit(trace.t, trace.i_q, command)
     run = ident.run_
     warnings = command_warnings(trace.t, trace.theta_cmd, monitor.calibration)
-    fits = ident.fit_nrmse_ <= FIT_NRMSE_LIMIT
+    fits = explains(ident.fit_nrmse_)
     if not fits:
         warnings.append(
             f"the monitor cannot explain this recording (NRMSE {100 * ident.fit_nrmse_:.3g} % of the "

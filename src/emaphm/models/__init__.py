@@ -30,6 +30,7 @@ __all__ = [
     "MonitorEma",
     "check_seed",
     "controller_pack",
+    "make_model",
     "mechanics_pack",
     "monitor_rows",
     "simulate",
@@ -67,12 +68,22 @@ def simulate(
     calibration : Calibration or path, optional
         The monitor model's calibration (``model="lf"`` only; the packaged one by default).
     """
+    ema = make_model(model, params=params, command=command, calibration=calibration)
+    return ema.simulate(faults, noise=noise, seed=seed, duration=duration)
+
+
+def make_model(
+    model: str = "hf",
+    *,
+    params: EmaParams | None = None,
+    command: Command | None = None,
+    calibration: Calibration | str | os.PathLike[str] | None = None,
+) -> HighFidelityEma | MonitorEma:
+    """The model named `model` ("hf" or "lf"); `calibration` only for the monitor (`InputError` else)."""
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; available: {', '.join(MODELS)}")
     if model == "lf":
-        ema: HighFidelityEma | MonitorEma = MonitorEma(params, command, calibration)
-    elif calibration is not None:
-        raise InputError("a calibration applies to the monitor model only (model='lf')")
-    else:
-        ema = HighFidelityEma(params, command)
-    return ema.simulate(faults, noise=noise, seed=seed, duration=duration)
+        return MonitorEma(params, command, calibration)
+    if calibration is not None:
+        raise InputError("a calibration applies to the monitor model only (--model lf, model='lf')")
+    return HighFidelityEma(params, command)
