@@ -1,11 +1,15 @@
 """Multi-fault identification (issue 8): accuracy, wrong basins and time on random actuators.
 
     python benchmarks/bench_multifault.py [--cases 40] [--seeds 2] [--restarts 3] [--case-seed 2611]
+                                          [--monitor default|paper] [--command chirp|chirp-2s|chirp-hold|steps]
 
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) drawn from --case-seed, a seed of this
 script's own (the calibration and `bench_identify.py` use others). Each case is identified with
 seeds 1..--seeds exactly as ``emaphm identify --true-faults K --seed S`` does: seed S is split
-into the twin's noise seed (a fresh measurement per seed) and the optimiser's seed.
+into the twin's noise seed (a fresh measurement per seed) and the optimiser's seed. --command runs
+the twin under another of the calibration's commands (the trace is then identified as a recording,
+``emaphm identify --reference``); --monitor picks the monitor model (the paper's, eqs. 1-2 alone, or
+the default one).
 
 Printed per case and in summary:
 - LF-vs-HF NRMSE at the truth (noise off, 150 Hz filtered): the monitor's bias for that actuator;
@@ -28,9 +32,9 @@ import time
 import numpy as np
 
 import emaphm
-from emaphm.commands import Chirp
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
+from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.fitness import Fitness
 from emaphm.models import HighFidelityEma, MonitorEma
 
@@ -54,16 +58,19 @@ def main() -> None:
     parser.add_argument("--restarts", type=int, default=3, help="extra optimiser seeds per measurement")
     parser.add_argument("--case-seed", type=int, default=2611)
     parser.add_argument("--optimizer", default="ga")
+    parser.add_argument("--monitor", default="default", choices=("default", "paper"))
+    parser.add_argument("--command", default="chirp", choices=tuple(CALIBRATION_COMMANDS))
     args = parser.parse_args()
     cpu = next(
         (ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?"
     )
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
           f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
-          f"optimizer {args.optimizer}")  # fmt: skip
+          f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}")  # fmt: skip
     cases = random_faults(args.cases, args.case_seed)
-    monitor = MonitorEma()
-    hf = HighFidelityEma(command=Chirp())
+    command = CALIBRATION_COMMANDS[args.command]
+    monitor = MonitorEma(command=command, monitor=args.monitor)
+    hf = HighFidelityEma(command=command)
     errs, walls, wrong, bias_runs, nrmses = [], [], 0, 0, []
     print(
         f"{'case':>4} {'NRMSE':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'wall':>5}  shorts"
@@ -76,12 +83,14 @@ def main() -> None:
         for s in range(1, args.seeds + 1):
             trace = hf.simulate(k, noise=True, seed=noise_seed_of(s))
             t0 = time.perf_counter()
-            run = emaphm.identify(reference=trace, seed=s, optimizer=args.optimizer)
+            run = emaphm.identify(reference=trace, seed=s, optimizer=args.optimizer, monitor=args.monitor)
             walls.append(time.perf_counter() - t0)
             err = emaphm.percent_error(run.estimate, k)
             errs.append(err)
             others = [
-                emaphm.identify(reference=trace, seed=1000 * r + s, optimizer=args.optimizer).fitness
+                emaphm.identify(
+                    reference=trace, seed=1000 * r + s, optimizer=args.optimizer, monitor=args.monitor
+                ).fitness
                 for r in range(1, args.restarts + 1)
             ]
             f_best = min([run.fitness, *others])

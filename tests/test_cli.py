@@ -240,3 +240,20 @@ def test_identify_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, monkeyp
     code, stdout, err = run_cli(args, capsys)
     assert code == 2 and reason in err and len(err.strip().splitlines()) == 1
     assert stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_monitor_is_chosen_by_name_on_the_command_line(tmp_path, capsys):
+    out = tmp_path / "lf.h5"
+    code, _, err = run_cli(
+        ["simulate", "--model", "lf", "--monitor", "paper", "--duration", "0.05", "--output", str(out)],
+        capsys,
+    )
+    assert code == 0, err
+    assert read_trace(out).metadata["monitor"] == "paper"
+    for args, message in (
+        (["--model", "lf", "--monitor", "three-phase"], "unknown monitor 'three-phase'"),
+        (["--monitor", "paper"], "monitor model only"),
+    ):
+        target = tmp_path / "x.h5"
+        code, _, err = run_cli(["simulate", *args, "--duration", "0.05", "--output", str(target)], capsys)
+        assert code == 2 and message in err and not target.exists()

@@ -1,5 +1,6 @@
 """The calibrated LF monitor model against the HF twin, and its calibration file."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -7,29 +8,78 @@ import pytest
 
 import emaphm
 from emaphm import InputError, MonitorEma
-from emaphm.calibration import Calibration, Coefficients, default_calibration, load_calibration
+from emaphm.calibration import Calibration, Coefficients, default_calibration, load_calibration, params_hash
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CHECK_SCENARIOS, FIT_SCENARIOS, calibrate
+from emaphm.identification.calibrate import (
+    CALIBRATION_COMMANDS,
+    CHECK_SCENARIOS,
+    FIT_SCENARIOS,
+    PAPER_CHECK_SCENARIOS,
+    PAPER_FIT_SCENARIOS,
+    calibrate,
+)
 from tests.helpers import faults
 
 # DESIGN §4 target for the calibrated LF model against the HF twin (filtered i_q, noise off), on
-# scenarios the calibration never saw. Measured live: 1.31-2.97 % (Table 1 vector the highest;
-# docs/theory/monitor-model.md §4)
-NRMSE_TARGET = 0.05
+# scenarios the calibration never saw: 5 % on the fitted commands (measured 0.7-2.9 %, the Table 1
+# vector 2.7 %). The chirp run on to 2 s and the chirp with a hold are held out altogether; there
+# the twin itself is chaotic (HF against HF with k1 + 1e-5: 1.7-4.4 %) and its own loop error
+# larger (its demand against its current: 3.3-8.6 %), and the monitor measured 3.2-14.5 %
+# (docs/theory/monitor-model.md §4): the bound there guards against a regression, no more.
+NRMSE_TARGET = {"chirp": 0.05, "steps": 0.05, "chirp-2s": 0.16, "chirp-hold": 0.16}
 
 
 def test_held_out_scenarios_are_not_fitted():
-    fitted = {s.faults for s in FIT_SCENARIOS}
-    assert len(CHECK_SCENARIOS) >= 8 and not any(s.faults in fitted for s in CHECK_SCENARIOS)
+    for fit, check in ((FIT_SCENARIOS, CHECK_SCENARIOS), (PAPER_FIT_SCENARIOS, PAPER_CHECK_SCENARIOS)):
+        fitted = {(s.faults, s.command) for s in fit}
+        assert len(check) >= 8 and not any((s.faults, s.command) in fitted for s in check)
+    # the default monitor is fitted on the chirp and the steps, and checked on every command
+    assert {s.command for s in FIT_SCENARIOS} == {"chirp", "steps"}
+    assert {s.command for s in CHECK_SCENARIOS} == set(CALIBRATION_COMMANDS)
+
+
+def test_the_paper_monitor_is_the_same_model_without_its_loop_surrogate():
+    paper = MonitorEma(monitor="paper")
+    c = paper.calibration.coefficients
+    assert paper.monitor == "paper" and (c.k_H, c.delta_0, c.delta_1, c.delta_2) == (0.0, 0.0, 0.0, 0.0)
+    assert MonitorEma().monitor == "default" and MonitorEma().calibration.coefficients.delta_0 > 0
+    assert paper.calibration.record["settings"]["fitted"] == [
+        "k_FS",
+        "k_E",
+        "k_t_eq",
+        "k_e_eq",
+        "J_eq",
+        "tau_i",
+    ]
+    # and it gives another current than the default monitor on a multi-fault actuator
+    k = faults(k1=0.2, k3=0.2, k4=0.3)
+    assert not np.allclose(paper.simulate(k).i_q, MonitorEma().simulate(k).i_q)
+    # the surrogate switched off in the default coefficients is the paper's structure, bit for bit
+    coeffs = dataclasses.replace(c, V_H=0.02)
+    np.testing.assert_array_equal(
+        MonitorEma(calibration=Calibration(coeffs)).simulate(k).i_q, paper.simulate(k).i_q
+    )
+
+
+def test_a_monitor_choice_that_does_not_match_the_calibration_is_refused(tmp_path):
+    with pytest.raises(InputError, match="unknown monitor"):
+        MonitorEma(monitor="three-phase")
+    path = default_calibration("paper").save(tmp_path / "paper.json")
+    assert MonitorEma(calibration=path).monitor == "paper"
+    with pytest.raises(InputError, match="for the 'paper' monitor, not 'default'"):
+        MonitorEma(calibration=path, monitor="default")
+    with pytest.raises(InputError, match="monitor model only"):
+        emaphm.simulate(emaphm.HEALTHY, monitor="paper", duration=0.01)
 
 
 @pytest.mark.parametrize("scenario", CHECK_SCENARIOS, ids=lambda s: s.name)
 def test_calibrated_lf_matches_hf_on_held_out_scenarios(scenario):
-    hf = emaphm.simulate(scenario.faults, noise=False)
-    lf = emaphm.simulate(scenario.faults, model="lf", noise=False)
+    command = CALIBRATION_COMMANDS[scenario.command]
+    hf = emaphm.simulate(scenario.faults, noise=False, command=command)
+    lf = emaphm.simulate(scenario.faults, model="lf", noise=False, command=command)
     np.testing.assert_array_equal(lf.t, hf.t)
     ref = Comparison.from_signal(hf.t, hf.i_q, 1e4)
-    assert ref.nrmse(lf.i_q) < NRMSE_TARGET
+    assert ref.nrmse(lf.i_q) < NRMSE_TARGET[scenario.command]
 
 
 def test_uncalibrated_lf_is_worse_on_shorts():
@@ -72,12 +122,22 @@ def test_fault_matrix_validation():
 
 def test_packaged_calibration_is_complete():
     # schema only: the LF-vs-HF figures are checked live above, not read from this file
-    cal = default_calibration()
-    for key in ("seed", "package_version", "fit_scenarios", "check_scenarios", "settings"):
-        assert key in cal.record
-    assert [s["name"] for s in cal.record["fit_scenarios"]] == [s.name for s in FIT_SCENARIOS]
-    assert [s["name"] for s in cal.record["check_scenarios"]] == [s.name for s in CHECK_SCENARIOS]
-    assert all(isinstance(s["nrmse"], float) for s in cal.record["check_scenarios"])
+    for monitor, fit, check in (
+        ("default", FIT_SCENARIOS, CHECK_SCENARIOS),
+        ("paper", PAPER_FIT_SCENARIOS, PAPER_CHECK_SCENARIOS),
+    ):
+        cal = default_calibration(monitor)
+        for key in ("seed", "package_version", "fit_scenarios", "check_scenarios", "settings", "versions"):
+            assert key in cal.record
+        assert cal.monitor == monitor
+        assert [(s["name"], s["command"]) for s in cal.record["fit_scenarios"]] == [
+            (s.name, s.command) for s in fit
+        ]
+        assert [(s["name"], s["command"]) for s in cal.record["check_scenarios"]] == [
+            (s.name, s.command) for s in check
+        ]
+        assert all(isinstance(s["nrmse"], float) for s in cal.record["check_scenarios"])
+        assert cal.params_hash == params_hash(emaphm.EmaParams())
 
 
 def test_calibration_round_trip(tmp_path):
@@ -92,6 +152,7 @@ def test_calibration_round_trip(tmp_path):
         ("{not json", "corrupt"),
         ('{"format": "other"}', "not an emaphm"),
         ('{"format": "emaphm-lf-calibration", "format_version": 99}', "format version"),
+        ('{"format": "emaphm-lf-calibration", "format_version": 2}', "older emaphm.*calibrate again"),
     ],
 )
 def test_bad_calibration_files(tmp_path, content, match):
@@ -124,3 +185,18 @@ def test_small_calibration_is_seeded_and_recorded():
     assert a.record["seed"] == 4 and a.record["settings"]["evaluations"] == 12
     assert [s["name"] for s in a.record["check_scenarios"]] == [CHECK_SCENARIOS[0].name]
     assert a.record["ga_history"][-1] <= a.record["ga_history"][0]
+
+
+def test_a_paper_calibration_fits_only_the_papers_coefficients():
+    cal = calibrate(
+        monitor="paper",
+        seed=4,
+        pop_size=6,
+        generations=1,
+        fit=PAPER_FIT_SCENARIOS[:1],
+        check=PAPER_CHECK_SCENARIOS[:1],
+    )
+    c = cal.coefficients
+    assert cal.monitor == "paper" and (c.k_H, c.delta_0, c.delta_1, c.delta_2) == (0.0, 0.0, 0.0, 0.0)
+    with pytest.raises(InputError, match="unknown monitor"):
+        calibrate(monitor="other", pop_size=6, generations=1)

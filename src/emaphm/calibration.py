@@ -38,6 +38,7 @@ __all__ = [
     "Calibration",
     "Coefficients",
     "actuator_params",
+    "check_monitor",
     "default_calibration",
     "load_calibration",
     "params_hash",
@@ -46,7 +47,7 @@ __all__ = [
 NOT_ACTUATOR = ("sigma_current", "sigma_position")  # noise levels: not part of what is calibrated
 
 FORMAT = "emaphm-lf-calibration"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 
 # GA search bounds of each calibrated coefficient (SI)
 COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -59,7 +60,9 @@ COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
     "k_H": (-0.1, 0.1),  # [-]
     "delta_0": (0.0, 0.02),  # [A]
     "delta_1": (0.0, 0.1),  # [A]
-    "omega_H": (0.1, 20.0),  # [rad/s]
+    "delta_u": (-0.05, 0.1),  # [A]
+    "delta_2": (-0.05, 0.05),  # [A]
+    "V_H": (1e-4, 0.05),  # [V]
 }
 
 
@@ -80,7 +83,9 @@ class Coefficients:
     k_H : float  2θ_e ripple of the loop's current per unit of lost turns [-]
     delta_0 : float  loop offset of the measured current, healthy [A]
     delta_1 : float  growth of that offset per unit of lost turns Σ(1 − N_x) [A]
-    omega_H : float  motor speed over which the offset reverses with the rotation [rad/s]
+    delta_u : float  growth of that offset with the unbalance of the lost turns |U| (kernels.monitor.unbalance) [A]
+    delta_2 : float  part of that offset in step with the shorted phases' 2θ_e pattern c₂ [A]
+    V_H : float  q-axis voltage (R_eq·i + k_e,eq·ω_m) over which the offset reverses its sign [V]
     """
 
     k_FS: float = 1.0
@@ -92,7 +97,9 @@ class Coefficients:
     k_H: float = 0.0
     delta_0: float = 0.0
     delta_1: float = 0.0
-    omega_H: float = 1.0
+    delta_u: float = 0.0
+    delta_2: float = 0.0
+    V_H: float = 0.01
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
@@ -143,23 +150,29 @@ class Calibration:
     record: dict[str, Any] = field(default_factory=dict)
 
     @property
+    def monitor(self) -> str:
+        """The monitor model calibrated: "default" or "paper" (the surrogate off, eqs. 1–2 alone)."""
+        return str(self.record.get("monitor", "default"))
+
+    @property
     def params(self) -> dict[str, dict[str, Any]] | None:
         """The parameters (`EmaParams.to_dict` form) this calibration was fitted for, if recorded."""
         params = self.record.get("settings", {}).get("params")
         return params if isinstance(params, dict) else None
 
     def command(self) -> Any:
-        """The position command the calibration was fitted under (None if not recorded or sampled)."""
-        from .commands import make_command
+        """The main position command the calibration was fitted under (None if not recorded or sampled)."""
+        return _command_of(self.record.get("settings", {}).get("command"))
 
-        rec = dict(self.record.get("settings", {}).get("command") or {})
-        kind = rec.pop("type", None)
-        if kind is None or kind == "sampled":
-            return None
-        try:
-            return make_command(kind, **rec)
-        except InputError:
-            return None
+    def commands(self) -> dict[str, Any]:
+        """Every position command the calibration was fitted under, by name ({} if none is recorded)."""
+        settings = self.record.get("settings", {})
+        recorded = settings.get("commands")
+        if not isinstance(recorded, dict):
+            main = self.command()
+            return {} if main is None else {"main": main}
+        built = {name: _command_of(rec) for name, rec in recorded.items()}
+        return {name: c for name, c in built.items() if c is not None}
 
     @property
     def params_hash(self) -> str | None:
@@ -214,12 +227,36 @@ class Calibration:
         return p
 
 
+def _command_of(record: Any) -> Any:
+    """The command a `command_record` describes (None if it is missing, sampled or not buildable)."""
+    from .commands import make_command
+
+    rec = dict(record) if isinstance(record, dict) else {}
+    kind = rec.pop("type", None)
+    if kind is None or kind == "sampled":
+        return None
+    try:
+        return make_command(kind, **rec)
+    except InputError:
+        return None
+
+
 def _parse(data: Any, where: str) -> Calibration:
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"{where}: not an emaphm LF calibration file")
     if data.get("format_version") != FORMAT_VERSION:
+        older = isinstance(data.get("format_version"), int) and data["format_version"] < FORMAT_VERSION
         raise InputError(
             f"{where}: calibration format version {data.get('format_version')!r}, expected {FORMAT_VERSION}"
+            + (
+                "; it was written by an older emaphm for another monitor model: run emaphm calibrate again"
+                if older
+                else ""
+            )
+        )
+    if data.get("monitor", "default") not in MONITOR_FILES:
+        raise InputError(
+            f"{where}: unknown monitor {data.get('monitor')!r}; expected one of {', '.join(MONITOR_FILES)}"
         )
     coeffs = data.get("coefficients")
     if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
@@ -254,8 +291,23 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
     return _parse(data, str(p))
 
 
-@functools.lru_cache(maxsize=1)
-def default_calibration() -> Calibration:
-    """The calibration shipped with the package (``emaphm/data/calibration.json``), read once."""
-    data = read_package_json("calibration.json")
-    return _parse(data, "emaphm/data/calibration.json")
+# the packaged calibration of each monitor model (issue 8): the default monitor, and the paper's
+# single-phase model with its shape functions alone (eqs. 1–2, no loop-error surrogate)
+MONITOR_FILES = {"default": "calibration.json", "paper": "calibration-paper.json"}
+
+
+def check_monitor(monitor: str) -> str:
+    """`monitor` if it names a packaged monitor model, else `InputError`."""
+    if monitor not in MONITOR_FILES:
+        raise InputError(f"unknown monitor {monitor!r}; choose one of {', '.join(MONITOR_FILES)}")
+    return monitor
+
+
+@functools.lru_cache(maxsize=len(MONITOR_FILES))
+def default_calibration(monitor: str = "default") -> Calibration:
+    """The calibration shipped with the package for `monitor` (``emaphm/data/calibration*.json``), read once."""
+    name = MONITOR_FILES[check_monitor(monitor)]
+    cal = _parse(read_package_json(name), f"emaphm/data/{name}")
+    if cal.monitor != monitor:
+        raise InputError(f"emaphm/data/{name} holds the {cal.monitor!r} monitor, not {monitor!r}")
+    return cal

@@ -25,6 +25,10 @@ from ._version import __version__
 from .errors import InputError, SimulationError
 
 CALIBRATION_HELP = "LF calibration file from 'emaphm calibrate' (default: the packaged one)."
+MONITOR_HELP = (
+    "Monitor model: 'default', or 'paper' (the paper's single-phase model, eqs. 1-2 alone); "
+    "default: the calibration's."
+)
 
 app = typer.Typer(
     name="emaphm",
@@ -38,7 +42,7 @@ err = Console(stderr=True, highlight=False)
 
 # literals, so that the CLI starts without numpy (tests/test_cli.py checks them against the code)
 HEALTHY_TEXT = "0,0,0,0,0,0,0,0.5"  # emaphm.faults.HEALTHY
-COMMAND_NAMES = ("chirp", "step", "ramp", "sine")  # emaphm.commands.COMMANDS
+COMMAND_NAMES = ("chirp", "chirp-hold", "steps", "step", "ramp", "sine")  # emaphm.commands.COMMANDS
 
 
 def _status(message: str) -> Any:
@@ -81,6 +85,7 @@ def simulate(
     calibration: Annotated[
         Path | None, typer.Option(help=CALIBRATION_HELP + " Only with --model lf.")
     ] = None,
+    monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP + " Only with --model lf.")] = None,
 ) -> None:
     """Simulate the actuator with a fault vector and write the sampled signals."""
     from .commands import make_command
@@ -91,7 +96,7 @@ def simulate(
     k = parse_faults(faults)
     check_seed(seed)
     check_output_path(output, suffixes=TRACE_SUFFIXES, inputs=(calibration,))  # before the work
-    ema = make_model(model, command=make_command(command), calibration=calibration)
+    ema = make_model(model, command=make_command(command), calibration=calibration, monitor=monitor)
     ema.sample_grid(duration)  # a duration no run can have: before the work
     with _status(f"simulating {model.upper()} twin ({describe(k)})"):
         result = ema.simulate(k, noise=noise, seed=seed, duration=duration)
@@ -125,6 +130,7 @@ def identify(
         Path | None, typer.Option("--output", "-o", help="Also write the JSON result here.")
     ] = None,
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
+    monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current."""
     import json
@@ -147,7 +153,7 @@ def identify(
     with _progress() as update:
         result = run_identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
-            generations=generations, local_polish=polish, calibration=calibration,
+            generations=generations, local_polish=polish, calibration=calibration, monitor=monitor,
             on_generation=lambda gen, total, best: update(f"{optimizer.upper()} generations", gen, total),
         )  # fmt: skip
     data = result.to_json()
@@ -196,6 +202,9 @@ def calibrate(
     pop_size: Annotated[int, typer.Option(help="GA population size.")] = 60,
     generations: Annotated[int, typer.Option(help="GA generations.")] = 150,
     workers: Annotated[int, typer.Option(help="Threads for the population kernel (0: all cores).")] = 0,
+    monitor: Annotated[
+        str, typer.Option(help="Monitor model to calibrate: 'default', or 'paper' (eqs. 1-2 alone).")
+    ] = "default",
 ) -> None:
     """Re-run the LF calibration against the HF twin and write the calibration file."""
     from .identification.calibrate import calibrate as run_calibration
@@ -205,7 +214,9 @@ def calibrate(
     check_seed(seed)
     check_output_path(output, suffixes=(".json",))
     with numba_threads(workers, name="--workers"), _progress() as update:
-        cal = run_calibration(seed=seed, pop_size=pop_size, generations=generations, progress=update)
+        cal = run_calibration(
+            monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update
+        )
     cal.save(output)
     for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
         values = [s["nrmse"] for s in cal.record[key]]
@@ -246,12 +257,13 @@ def demo(
     optimizer: Annotated[str, typer.Option(help="ga, de, pso, cmaes or gwo.")] = "ga",
     runs: Annotated[int, typer.Option(help="Identifications (optimiser seeds 1..runs).")] = 5,
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
+    monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
 ) -> None:
     """The main job: the paper's Table 1 experiment (HF twin with noise, five identifications)."""
     from .demo import run_demo
 
     run_demo(
-        output_dir, seed=seed, optimizer=optimizer, runs=runs, calibration=calibration,
+        output_dir, seed=seed, optimizer=optimizer, runs=runs, calibration=calibration, monitor=monitor,
         console=_stdout_console(), status=_status,
     )  # fmt: skip
 

@@ -1,7 +1,8 @@
 """Position command profiles θ_cmd(t) on the user (surface) side [rad].
 
-`Chirp` is the FDI test manoeuvre of DESIGN §6/§7 and the default; `Step`, `Ramp` and `Sine` are
-for exploring the model. Every command is a frozen dataclass with a `duration` [s] and is called
+`Chirp` is the FDI test manoeuvre of DESIGN §6/§7 and the default; `ChirpHold` (the chirp, then
+a hold) and `Steps` (a staircase) are other manoeuvres a rig records, on which the monitor is
+also calibrated; `Step`, `Ramp` and `Sine` are for exploring the model. Every command is a frozen dataclass with a `duration` [s] and is called
 on an array of times [s] to give θ_cmd [rad].
 """
 
@@ -20,11 +21,13 @@ from .errors import InputError
 __all__ = [
     "COMMANDS",
     "Chirp",
+    "ChirpHold",
     "Command",
     "Ramp",
     "SampledCommand",
     "Sine",
     "Step",
+    "Steps",
     "command_record",
     "make_command",
 ]
@@ -44,11 +47,13 @@ class _Checked:
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             v = getattr(self, f.name)
+            if isinstance(v, (tuple, list)):  # a sequence field: its class checks it
+                continue
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise InputError(f"{type(self).__name__}.{f.name} must be a finite number, got {v!r}")
-            if f.name in ("duration", "T", "V_max", "f0", "f1", "frequency") and v <= 0:
+            if f.name in ("duration", "T", "V_max", "f0", "f1", "frequency", "dwell", "ramp") and v <= 0:
                 raise InputError(f"{type(self).__name__}.{f.name} must be > 0, got {v!r}")
-            if f.name in ("t_f", "t_0", "A_max") and v < 0:
+            if f.name in ("t_f", "t_0", "A_max", "hold") and v < 0:
                 raise InputError(f"{type(self).__name__}.{f.name} must be >= 0, got {v!r}")
 
 
@@ -87,6 +92,51 @@ class Chirp(_Checked):
         else:
             w = np.ones_like(t)
         return w * A * np.sin(phase)
+
+
+@dataclass(frozen=True)
+class ChirpHold(Chirp):
+    """The chirp (`Chirp`, over T), then a ramp back to zero over `ramp` [s], then a hold to T + hold.
+
+    A rig that runs the FDI chirp and then parks the surface records this (issue 8, item 5).
+    """
+
+    hold: float = 1.0
+    ramp: float = 0.05
+
+    @property
+    def duration(self) -> float:
+        return self.T + self.hold
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        end = float(Chirp.__call__(self, np.array([self.T]))[0])
+        back = end * np.clip(1.0 - (t - self.T) / self.ramp, 0.0, 1.0)
+        return np.where(t <= self.T, Chirp.__call__(self, np.minimum(t, self.T)), back)
+
+
+@dataclass(frozen=True)
+class Steps(_Checked):
+    """A staircase: θ_cmd holds `levels[j]` [rad] over [j·dwell, (j + 1)·dwell), the last level to the end."""
+
+    levels: tuple[float, ...] = (0.0, 0.03, -0.02, 0.045, 0.0, -0.04, 0.02, -0.01, 0.035, -0.03)
+    dwell: float = 0.2
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        levels = tuple(self.levels)
+        if not levels or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in levels):
+            raise InputError(f"Steps.levels must be a non-empty list of finite numbers, got {self.levels!r}")
+        object.__setattr__(self, "levels", tuple(float(v) for v in levels))
+
+    @property
+    def duration(self) -> float:
+        return self.dwell * len(self.levels)
+
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        j = np.clip(np.floor(t / self.dwell + 1e-9), 0, len(self.levels) - 1).astype(np.intp)
+        return np.asarray(self.levels, dtype=np.float64)[j]
 
 
 @dataclass(frozen=True)
@@ -158,14 +208,18 @@ def command_record(command: Command) -> dict[str, Any]:
     """A JSON-ready description of a command, for result metadata."""
     if isinstance(command, SampledCommand):
         return {"type": "sampled", "samples": len(command.t), "duration": command.duration}
-    return {"type": type(command).__name__.lower(), **vars(command)}
+    name = next((n for n, cls in COMMANDS.items() if type(command) is cls), type(command).__name__.lower())
+    return {"type": name, **{k: list(v) if isinstance(v, tuple) else v for k, v in vars(command).items()}}
 
 
-COMMANDS: dict[str, type] = {"chirp": Chirp, "step": Step, "ramp": Ramp, "sine": Sine}
+COMMANDS: dict[str, type] = {
+    "chirp": Chirp, "chirp-hold": ChirpHold, "steps": Steps, "step": Step, "ramp": Ramp, "sine": Sine,
+}  # fmt: skip
 
 
 def make_command(name: str, **settings: Any) -> Command:
-    """Build a command by name (``chirp``, ``step``, ``ramp``, ``sine``) with optional settings."""
+    """Build a command by name (``chirp``, ``chirp-hold``, ``steps``, ``step``, ``ramp``, ``sine``)
+    with optional settings."""
     try:
         cls = COMMANDS[name]
     except KeyError:

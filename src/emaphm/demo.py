@@ -44,13 +44,15 @@ def run_demo(
     optimizer: str = "ga",
     runs: int = 5,
     calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
     console: Console | None = None,
     status: Callable[[str], Any] | None = None,
     budget: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run the Table 1 experiment; print its table, write its figures, return its figures.
 
-    `calibration` is the LF calibration (default: the packaged one); `budget` passes
+    `calibration` is the LF calibration (default: the packaged one of `monitor`, "default" or
+    "paper"); `budget` passes
     ``pop_size``, ``generations`` and ``local_polish`` to `identify` (the defaults otherwise:
     tests use a small one).
     """
@@ -65,7 +67,7 @@ def run_demo(
         raise InputError(f"runs must be >= 1, got {runs}")
     check_optimizer(optimizer)
     check_seed(seed)
-    monitor = MonitorEma(calibration=calibration)  # a calibration for other parameters: refused now
+    monitor_model = MonitorEma(calibration=calibration, monitor=monitor)  # refused now if it does not fit
 
     def stage(message: str) -> Any:
         return status(message) if status else nullcontext()
@@ -82,7 +84,7 @@ def run_demo(
                     reference=measured,
                     optimizer=optimizer,
                     seed=run_seed,
-                    calibration=monitor.calibration,
+                    calibration=monitor_model.calibration,
                     **(budget or {}),
                 )
             )
@@ -115,7 +117,7 @@ def run_demo(
 
     output_dir.mkdir(parents=True, exist_ok=True)
     best = results[int(np.argmin([r.fitness for r in results]))]
-    lf = monitor.simulate(best.estimate)
+    lf = monitor_model.simulate(best.estimate)
     figures = [
         plot_response({"healthy": healthy, "Table 1 faults": measured}, output_dir / "hf_table1.png",
                       "High-fidelity EMA twin, FDI chirp (noise on)"),

@@ -1,4 +1,4 @@
-"""A trace recorded under another command than the calibrated one is flagged (issue 8, item 5)."""
+"""A trace recorded under another command than the calibrated ones is flagged (issue 8, item 5)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 
 import emaphm
 from emaphm.calibration import default_calibration
-from emaphm.commands import Chirp, Step
+from emaphm.commands import Chirp, ChirpHold, Step
 from emaphm.identification.coverage import command_warnings
 from tests.helpers import run_cli
 
@@ -21,28 +21,41 @@ def test_the_calibrated_chirp_raises_no_warning_at_any_sample_rate():
         assert command_warnings(t, Chirp()(t - t[0]), CAL) == []
 
 
-def test_a_longer_trace_is_flagged():
+def test_every_calibrated_command_raises_no_warning_and_a_part_of_one_neither():
+    commands = CAL.commands()
+    assert set(commands) == {"chirp", "chirp-2s", "chirp-hold", "steps"}
+    for command in commands.values():
+        t = np.arange(round(command.duration * 1e4) + 1) / 1e4
+        assert command_warnings(t, command(t), CAL) == []
+        assert command_warnings(t[: len(t) // 2], command(t[: len(t) // 2]), CAL) == []
+    # `emaphm simulate --duration 2`: the 1 s chirp swept on to 19.5 Hz is the chirp-2s command
     t = np.arange(20001) / 1e4
-    reasons = command_warnings(t, Chirp(T=2.0)(t), CAL)
-    assert any("runs 2 s" in r for r in reasons)
-    # the chirp followed by a hold: the first second matches, the rest is beyond the calibration
-    held = np.where(t <= 1.0, Chirp()(np.minimum(t, 1.0)), Chirp()(np.array([1.0]))[0])
-    reasons = command_warnings(t, held, CAL)
-    assert len(reasons) == 1 and "runs 2 s" in reasons[0]
+    assert command_warnings(t, Chirp()(t), CAL) == []
+    assert command_warnings(t, ChirpHold()(t), CAL) == []
+
+
+def test_a_longer_trace_is_flagged():
+    t = np.arange(30001) / 1e4
+    reasons = command_warnings(t, Chirp(T=3.0)(t), CAL)
+    assert len(reasons) == 1 and "runs 3 s" in reasons[0] and "at most 2 s" in reasons[0]
 
 
 def test_another_command_is_flagged_and_a_tiny_difference_is_not():
     t = np.arange(5001) / 1e4
-    assert any("differs" in r for r in command_warnings(t, Step()(t), CAL))
+    assert any("none of those" in r for r in command_warnings(t, Step()(t), CAL))
     chirp = Chirp()(t)
     assert command_warnings(t, chirp + 1e-6, CAL) == []  # ADC-level noise on a logged command
-    assert any("differs" in r for r in command_warnings(t, 1.1 * chirp, CAL))
+    assert any("none of those" in r for r in command_warnings(t, 1.1 * chirp, CAL))
+    # a hold at another level than the calibrated ramp back to zero
+    t = np.arange(20001) / 1e4
+    held = np.where(t <= 1.0, Chirp()(np.minimum(t, 1.0)), Chirp()(np.array([1.0]))[0])
+    assert any("none of those" in r for r in command_warnings(t, held, CAL))
 
 
 def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_path, capsys):
     trace = emaphm.simulate(emaphm.HEALTHY, model="lf", command=Step(), noise=False)
     r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
-    assert r.warnings and "differs" in r.warnings[0]
+    assert r.warnings and "none of those" in r.warnings[0]
     assert r.to_json()["warnings"] == r.warnings
     path = tmp_path / "step.h5"
     emaphm.write_trace(trace, path)
@@ -63,7 +76,7 @@ def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_
         capsys,
     )
     data = json.loads(out)
-    assert "emaphm: warning: the position command differs" in err
+    assert "emaphm: warning: the position command is none of those" in err
     assert data["warnings"] == r.warnings
     assert code == (0 if data["verdict"] == "fits" else 3)  # exit 3: ran, but no diagnosis
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from emaphm import InputError
+from emaphm.commands import Chirp
 from emaphm.identification.fitness import Fitness
 from emaphm.identification.signals import Comparison, lowpass, nrmse
 
@@ -64,3 +65,36 @@ def test_reference_on_another_grid_is_interpolated():
     np.testing.assert_allclose(c.reference, lowpass(signal(T), F_S), rtol=0, atol=1e-3)
     with pytest.raises(InputError, match="covers"):
         Comparison.from_trace(t_src[:100], np.zeros(100), T, F_S)
+
+
+def test_the_moving_mask_leaves_out_only_a_long_hold_where_the_surface_rests():
+    from emaphm.commands import ChirpHold, Steps
+    from emaphm.identification.fitness import REST_BAND, moving_mask
+
+    f_s = 1e4
+    t = np.arange(20001) / f_s
+    hold = ChirpHold()(t)  # the chirp to 1 s, back to zero by 1.05 s, then held
+    m = moving_mask(hold, f_s)
+    assert np.all(m[t <= 1.05 + 0.05] == 1.0) and np.all(m[t > 1.05 + 0.05 + 2e-4] == 0.0)
+    assert np.all(moving_mask(Chirp()(t), f_s) == 1.0)  # a chirp never holds
+    # with the surface position: left out only where it rests as well
+    at_rest = 0.3 * REST_BAND * np.sin(2 * np.pi * 50 * t)  # noise within the band
+    creeping = at_rest + np.where(t > 1.2, 100 * REST_BAND * (t - 1.2), 0.0)  # 5 bands per 50 ms
+    np.testing.assert_array_equal(moving_mask(hold, f_s, theta_u=at_rest), m)
+    kept = moving_mask(hold, f_s, theta_u=creeping)
+    assert np.all(kept[t > 1.3] == 1.0) and np.all(kept[(t > 1.11) & (t < 1.2)] == 0.0)
+    # steps of 0.2 s: held after 50 ms where the surface rests, never while it moves
+    steps = Steps(dwell=0.2)(t)
+    assert 0.2 < moving_mask(steps, f_s).mean() < 0.3
+
+
+def test_a_masked_fitness_ignores_the_left_out_samples():
+    current = 0.3 * np.sin(2 * np.pi * 4 * T)
+    ref = Comparison.from_signal(T, current, F_S)
+    mask = (T < 0.25).astype(float)
+    fit = Fitness(ref, "s", mask)
+    noisy_tail = current + np.where(T >= 0.3, 0.3, 0.0)
+    # a difference only where the mask is 0 costs nothing (up to the filter's spread at the edge)
+    assert fit(noisy_tail) < 1e-3 * Fitness(ref, "s")(noisy_tail)
+    with pytest.raises(ValueError, match="mask"):
+        Fitness(ref, "s", mask[:-1])

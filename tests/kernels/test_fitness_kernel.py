@@ -161,7 +161,7 @@ def test_a_diverged_row_gets_a_non_finite_fitness_and_the_others_do_not_change()
     clean = run_kernel(theta_cmd, rows, fitness)
     broken = rows.copy()
     broken[1, IDX["J"]] = np.nan  # NaN once static friction breaks (measured: from sample 285 of 2001)
-    broken[6, IDX["omega_H"]] = 0.0  # tanh(ω_m/ω_H) = tanh(0·inf): NaN from the second sample on
+    broken[6, IDX["V_H"]] = 0.0  # tanh((R·i + k_e·ω_m)/V_H) = tanh(0/0): NaN from the first sample on
     got = run_kernel(theta_cmd, broken, fitness)
     assert np.all(np.isfinite(clean))
     assert not np.isfinite(got[1]) and not np.isfinite(got[6])  # 6: the odd row out, paired with zeros

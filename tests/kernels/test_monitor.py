@@ -10,10 +10,13 @@ from emaphm.kernels.monitor import (
     LF_FIELDS,
     N_AUX,
     N_FIELDS,
+    loop_error,
     phi_ecc,
     phi_sc,
     simulate_lf,
     simulate_lf_many,
+    unbalance,
+    unbalance_2,
 )
 
 THETA = np.linspace(0, 2 * np.pi, 720, endpoint=False)
@@ -81,3 +84,26 @@ def test_index_constants_match_the_row_layout():
     others = {"N_FIELDS", "N_AUX"}
     constants = {n for n, v in vars(lf_kernel).items() if n.isupper() and type(v) is int and n not in others}
     assert constants == {name.upper() for name in LF_FIELDS}
+
+
+@pytest.mark.parametrize(
+    "N", [(1.0, 1.0, 1.0), (0.7, 1.0, 1.0), (1.0, 0.55, 0.9), (0.6, 0.6, 0.6), (0.8, 0.5, 0.95)]
+)
+def test_unbalance_is_the_amplitude_of_the_2theta_pattern(N):
+    # c2(θ) = Σ (1 − N_x)·cos(2θ − 2γ_x) is a pure 2θ term whose amplitude is |U|, 0 when balanced
+    c2 = np.array([unbalance_2(np.sin(t), np.cos(t), *N) for t in THETA])
+    assert abs(harmonic(c2, 2)) == pytest.approx(unbalance(*N), abs=1e-12)
+    assert np.max(np.abs(c2)) == pytest.approx(unbalance(*N), abs=1e-4)
+    assert abs(np.mean(c2)) < 1e-12
+    if N[0] == N[1] == N[2]:
+        assert unbalance(*N) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_loop_surrogate_carries_no_current_at_rest_and_opposes_the_voltage():
+    args = dict(k_H=0.01, delta_2=-0.01, R_eq=0.5, k_e_eq=0.1, V_H=0.002)
+    assert loop_error(0.0, 0.0, 0.3, 0.005, **args) == 0.0  # no demand, no motion: no current
+    # the offset takes current off in the direction of the q-axis voltage R·i + k_e·ω
+    assert 0.0 < loop_error(0.2, 0.0, 0.0, 0.005, **args) < 0.2
+    assert -0.2 < loop_error(-0.2, 0.0, 0.0, 0.005, **args) < 0.0
+    assert loop_error(0.0, 5.0, 0.0, 0.005, **args) == pytest.approx(-0.005)
+    assert loop_error(0.0, -5.0, 0.0, 0.005, **args) == pytest.approx(0.005)

@@ -1,18 +1,23 @@
 """Is a measurement inside what the monitor model was calibrated for? (issue 8, item 5)
 
-The monitor's coefficients are fitted on one command (the FDI chirp of DESIGN §6, 1 s). A trace
-recorded under another command, or running on after it (a 2 s chirp, the chirp followed by a
-hold), is still identified, but nothing has measured how well: a 2 s chirp gave 13 %err and the
-chirp followed by a hold 28–69 %err with the short in the wrong phase, where the calibrated 1 s
-chirp gives about 3. Such a result carries a warning instead of passing for a calibrated one.
+The monitor's coefficients are fitted on a few commands (the packaged calibration: the FDI chirp
+of DESIGN §6, that chirp run on for 2 s, the chirp followed by a hold, a staircase of steps;
+`identification.calibrate.CALIBRATION_COMMANDS`). A trace recorded under another command, or
+running on beyond them, is still identified, but nothing has measured how well: before the
+monitor was calibrated on them, a 2 s chirp gave 13 %err and the chirp followed by a hold
+28–69 %err with the short in the wrong phase, where the calibrated 1 s chirp gave about 3. Such a
+result carries a warning instead of passing for a calibrated one.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..calibration import Calibration
+from ..commands import Command
 
 __all__ = ["COMMAND_TOLERANCE", "command_warnings"]
 
@@ -21,34 +26,46 @@ __all__ = ["COMMAND_TOLERANCE", "command_warnings"]
 COMMAND_TOLERANCE = 1e-3
 
 
-def command_warnings(t: ArrayLike, theta_cmd: ArrayLike, calibration: Calibration) -> list[str]:
-    """Reasons why a trace's command lies outside the calibration's; [] when it does not.
+def _deviation(
+    times: NDArray[np.float64], theta: NDArray[np.float64], command: Command
+) -> tuple[float, float]:
+    """(largest |θ_cmd − command|, the command's peak) over the trace's times within the command."""
+    inside = times <= command.duration
+    if not inside.any():
+        return math.inf, 0.0
+    expected = np.asarray(command(times[inside]), dtype=np.float64)
+    return float(np.max(np.abs(theta[inside] - expected))), float(np.max(np.abs(expected)))
 
-    t [s] starts the trace (shifted to 0 here), theta_cmd [rad] is its position command.
+
+def command_warnings(t: ArrayLike, theta_cmd: ArrayLike, calibration: Calibration) -> list[str]:
+    """Reasons why a trace's command lies outside the calibration's commands; [] when it does not.
+
+    t [s] starts the trace (shifted to 0 here), theta_cmd [rad] is its position command. The trace
+    is inside when one calibrated command lasts at least as long and matches it over the trace.
     """
-    command = calibration.command()
-    if command is None:
+    commands = calibration.commands()
+    if not commands:
         return ["the calibration records no command: its accuracy on this one is unknown"]
     times = np.asarray(t, dtype=np.float64)
     times = times - times[0]
     theta = np.asarray(theta_cmd, dtype=np.float64)
-    reasons = []
-    span, duration = float(times[-1]), float(command.duration)
+    span = float(times[-1])
     # one sample period of slack: a 1 s command ends at 0.9999 s or 1.0 s depending on the logger
     step = float(np.median(np.diff(times))) if len(times) > 1 else 0.0
-    if span > duration + step + 1e-9:
-        reasons.append(
-            f"the trace runs {span:g} s, the monitor was calibrated on a {duration:g} s command: "
-            "its accuracy beyond that is not known"
-        )
-    inside = times <= duration
-    expected = np.asarray(command(times[inside]), dtype=np.float64)
-    peak = float(np.max(np.abs(expected))) if expected.size else 0.0
-    deviation = float(np.max(np.abs(theta[inside] - expected))) if expected.size else 0.0
-    if peak > 0.0 and deviation > COMMAND_TOLERANCE * peak:
-        reasons.append(
-            f"the position command differs from the one the monitor was calibrated on "
-            f"({type(command).__name__}, by up to {deviation:.3g} rad of {peak:.3g}): "
-            "the identification is not calibrated for it"
-        )
-    return reasons
+    longest = max(float(c.duration) for c in commands.values())
+    names = ", ".join(f"{name} ({c.duration:g} s)" for name, c in commands.items())
+    if span > longest + step + 1e-9:
+        return [
+            f"the trace runs {span:g} s, the monitor was calibrated on commands of at most {longest:g} s "
+            f"({names}): its accuracy beyond that is not known"
+        ]
+    for command in commands.values():
+        if span > float(command.duration) + step + 1e-9:
+            continue
+        deviation, peak = _deviation(times, theta, command)
+        if peak > 0.0 and deviation <= COMMAND_TOLERANCE * peak:
+            return []
+    return [
+        f"the position command is none of those the monitor was calibrated on ({names}): "
+        "the identification is not calibrated for it"
+    ]

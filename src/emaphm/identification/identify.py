@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,7 +30,7 @@ from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect
-from .fitness import Fitness
+from .fitness import Fitness, moving_mask
 from .metrics import absolute_errors, percent_error
 from .optimizers import OnGeneration, OptimizerRun, Stagnation, check_optimizer, polish, run_optimizer
 from .signals import Comparison
@@ -174,8 +175,18 @@ class FaultIdentifier:
         self.monitor = monitor
         self.on_generation = on_generation
 
-    def fit(self, t: ArrayLike, i_q: ArrayLike, command: Command | None = None) -> FaultIdentifier:
-        """Fit to the current i_q [A] sampled at t [s] under `command` (default: the FDI chirp)."""
+    def fit(
+        self,
+        t: ArrayLike,
+        i_q: ArrayLike,
+        command: Command | None = None,
+        theta_u: ArrayLike | None = None,
+    ) -> FaultIdentifier:
+        """Fit to the current i_q [A] sampled at t [s] under `command` (default: the FDI chirp).
+
+        `theta_u` [rad], the measured surface position at t if the trace has it, tells where the
+        surface is at rest in a hold of the command (`fitness.moving_mask`).
+        """
         seed = check_seed(self.seed)
         t = np.asarray(t, dtype=np.float64)
         i_q = np.asarray(i_q, dtype=np.float64)
@@ -201,7 +212,17 @@ class FaultIdentifier:
         duration = min(span, monitor.command.duration)
         grid, _ = monitor.sample_grid(duration)
         reference = Comparison.from_trace(t - t[0], i_q, grid, monitor.params.controller.f_s)
-        fitness = Fitness(reference, self.slope_unit)
+        # long holds of the command are left out (`moving_mask`): the held current is not the faults'
+        _, theta_grid = monitor.sample_grid(duration)
+        position = None
+        if theta_u is not None:
+            pos = np.asarray(theta_u, dtype=np.float64)
+            if pos.shape != t.shape or not np.all(np.isfinite(pos)):
+                raise InputError("theta_u must be finite and sampled at the reference's times")
+            position = np.interp(grid, t - t[0], pos)
+        mask = moving_mask(theta_grid, monitor.params.controller.f_s, theta_u=position)
+        self.compared_ = float(mask.mean())
+        fitness = Fitness(reference, self.slope_unit, mask)
 
         def evaluate(X: NDArray[np.float64]) -> NDArray[np.float64]:
             # one parallel kernel call: simulation, filter and eq. (3) fused per row, the same numbers
@@ -215,6 +236,7 @@ class FaultIdentifier:
         )  # fmt: skip
         if self.local_polish:
             run = polish(evaluate, run, seed=seed, on_generation=self.on_generation)
+        run, self.permutation_ = try_short_permutations(evaluate, run, seed=seed, polish_it=self.local_polish)
         self.wall_time_ = time.perf_counter() - start
         self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
         self.fitness_ = run.f
@@ -226,6 +248,39 @@ class FaultIdentifier:
         except SimulationError:
             self.fit_nrmse_ = float("inf")
         return self
+
+
+# the five other assignments of the three short magnitudes (k3, k4, k5) to the phases A, B, C
+SHORT_PERMUTATIONS = ((0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
+
+
+def try_short_permutations(
+    evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    run: OptimizerRun,
+    *,
+    seed: int = 0,
+    polish_it: bool = True,
+) -> tuple[OptimizerRun, list[int] | None]:
+    """Guard against the worst wrong basin: the shorts sized right but put in the wrong phases.
+
+    The fitness of the best point with its short magnitudes (k3, k4, k5) assigned to the phases in
+    the five other orders is evaluated (5 evaluations). If one fits better, it is polished (when
+    `polish_it`) and kept if it still beats the run. Returns the run and the order taken (a
+    permutation of [0, 1, 2]: the new k3..k5 are the old ones in that order), or None.
+    """
+    X = np.repeat(run.x[None, :], len(SHORT_PERMUTATIONS), axis=0)
+    for j, order in enumerate(SHORT_PERMUTATIONS):
+        X[j, 2:5] = run.x[[2 + o for o in order]]
+    f = np.asarray(evaluate(X), dtype=np.float64)
+    f = np.where(np.isfinite(f), f, np.inf)
+    best = int(np.argmin(f))
+    evaluations = run.evaluations + len(X)
+    if not f[best] < run.f:
+        return OptimizerRun(run.x, run.f, evaluations, run.history), None
+    better = OptimizerRun(X[best], float(f[best]), evaluations, run.history)
+    if polish_it:
+        better = polish(evaluate, better, seed=seed)
+    return better, list(SHORT_PERMUTATIONS[best])
 
 
 def search_to_faults(X: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -254,6 +309,7 @@ def identify(
     on_generation: OnGeneration | None = None,
     thresholds: dict[str, float] | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
 ) -> IdentificationResult:
     """Identify the faults from `reference` (a trace file or `SimResult`), or from the HF twin run
     with `true_faults` and noise on (DESIGN §8). Exactly one of the two must be given.
@@ -262,10 +318,12 @@ def identify(
     `thresholds` overrides the shipped detection thresholds ({} reports nothing). `calibration`
     is the LF calibration (a `Calibration` or the path of a file from ``emaphm calibrate``; the
     packaged one by default); one made for other actuator parameters raises `InputError`.
+    `monitor` picks the monitor model: "default", or "paper" (the paper's single-phase model,
+    eqs. 1–2 alone, to reproduce the paper); None: the calibration's (`MonitorEma`).
     """
     seed = check_seed(seed)
     check_optimizer(optimizer)  # before the twin runs
-    monitor = MonitorEma(calibration=calibration)  # a calibration that does not fit: before the work
+    monitor_model = MonitorEma(calibration=calibration, monitor=monitor)  # one that does not fit: now
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -292,12 +350,12 @@ def identify(
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
-        slope_unit=slope_unit, monitor=monitor, on_generation=on_generation,
+        slope_unit=slope_unit, monitor=monitor_model, on_generation=on_generation,
     )  # fmt: skip
     with numba_threads(workers):
-        ident.fit(trace.t, trace.i_q, command)
+        ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
     run = ident.run_
-    warnings = command_warnings(trace.t, trace.theta_cmd, monitor.calibration)
+    warnings = command_warnings(trace.t, trace.theta_cmd, monitor_model.calibration)
     fits = explains(ident.fit_nrmse_)
     if not fits:
         warnings.append(
@@ -313,6 +371,10 @@ def identify(
         "generations": generations,
         "generations_run": len(run.history),
         "local_polish": local_polish,
+        # the shorts' phase order the final check took over the search's (None: kept)
+        "short_permutation": ident.permutation_,
+        # the fraction of samples the fitness compares (long holds of the command are left out)
+        "samples_compared": round(ident.compared_, 4),
         "slope_unit": slope_unit,
         "workers": workers,
         "optimizer_wall_time_s": round(ident.wall_time_, 3),
@@ -322,8 +384,9 @@ def identify(
             else str(calibration)
             if not isinstance(calibration, Calibration)
             else "Calibration object",
-            "created": monitor.calibration.record.get("created"),
-            "params_hash": monitor.calibration.params_hash,
+            "created": monitor_model.calibration.record.get("created"),
+            "params_hash": monitor_model.calibration.params_hash,
+            "monitor": monitor_model.monitor,
         },
         "versions": versions(),
     }

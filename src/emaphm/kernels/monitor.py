@@ -40,7 +40,7 @@ LF_FIELDS = (
     # equivalent motor and calibration coefficients
     "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
     # current-loop surrogate of the three-phase hysteresis loop's error (calibrated)
-    "k_H", "delta_0", "delta_1", "omega_H",
+    "k_H", "delta_0", "delta_1", "delta_u", "delta_2", "V_H",
     # LF steps per sample period
     "n_lf",
 )  # fmt: skip
@@ -52,7 +52,7 @@ N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
  LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX,
- K_H, DELTA_0, DELTA_1, OMEGA_H, N_LF) = range(N_FIELDS)  # fmt: skip
+ K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, N_LF) = range(N_FIELDS)  # fmt: skip
 
 
 @jit
@@ -74,18 +74,44 @@ def phi_ecc(sin_e, cos_e, kz_cos, kz_sin):  # type: ignore[no-untyped-def]
 
 
 @jit
-def phi_hyst(sin_e, cos_e, N_a, N_b, N_c, k_H):  # type: ignore[no-untyped-def]
-    """Current-loop shape function: φ_H = 1 + k_H·Σ_x (1 − N_x)·cos(2θ_e − 2γ_x).
+def unbalance_2(sin_e, cos_e, N_a, N_b, N_c):  # type: ignore[no-untyped-def]
+    """c₂ = Σ_x (1 − N_x)·cos(2θ_e − 2γ_x): the 2θ_e pattern of the lost turns (0 when balanced).
 
-    A surrogate, like eqs. (1)–(2): with a shorted phase the three-phase hysteresis loop delivers
-    a current whose magnitude ripples at 2θ_e in step with that phase (cos(2θ_e − 2γ_x) = 1 − 2u_x²).
+    cos(2θ_e − 2γ_x) = 1 − 2u_x² with u_x the phase directions of `transforms.phase_directions`.
     """
     u_a, u_b, u_c = phase_directions(sin_e, cos_e)
-    return 1.0 + k_H * (
+    return (
         (1.0 - N_a) * (1.0 - 2.0 * u_a * u_a)
         + (1.0 - N_b) * (1.0 - 2.0 * u_b * u_b)
         + (1.0 - N_c) * (1.0 - 2.0 * u_c * u_c)
     )
+
+
+@jit
+def unbalance(N_a, N_b, N_c):  # type: ignore[no-untyped-def]
+    """|U|, U = Σ_x (1 − N_x)·e^(j2γ_x): the amplitude of c₂ (0 for equal shorts in all three phases).
+
+    |U|² = Σ a_x² − (a_A·a_B + a_B·a_C + a_C·a_A) with a_x = 1 − N_x, since cos(±4π/3) = −1/2.
+    """
+    a, b, c = 1.0 - N_a, 1.0 - N_b, 1.0 - N_c
+    return math.sqrt(max(a * a + b * b + c * c - a * b - b * c - c * a, 0.0))
+
+
+@jit
+def loop_error(i, omega_m, c2, offset_0, k_H, delta_2, R_eq, k_e_eq, V_H):  # type: ignore[no-untyped-def]
+    """The current the motor carries and the sensors measure, given the loop state i (monitor-model.md §1):
+
+        i_m = i·(1 + k_H·c₂) − (δ_H + δ_2·c₂)·tanh((R_eq·i + k_e,eq·ω_m)/V_H)
+        δ_H = δ_0 + δ_1·Σ_x (1 − N_x) + δ_U·|U|        (offset_0, constant over a run)
+
+    A calibrated surrogate of the three-phase hysteresis loop's own error: a 2θ_e ripple in step
+    with the shorted phases, and an offset that opposes the q-axis voltage the inverter must
+    supply (R_eq·i at standstill, where the delivered current falls short of the demand; the
+    back-EMF k_e,eq·ω_m in motion, where it trails the rotation). It grows with the turns lost
+    and with their unbalance between the phases (`unbalance`).
+    """
+    offset = offset_0 + delta_2 * c2
+    return i * (1.0 + k_H * c2) - offset * math.tanh((R_eq * i + k_e_eq * omega_m) / V_H)
 
 
 @jit
@@ -115,8 +141,8 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     HF i_q convention), and, when aux has rows, the `AUX_COLUMNS` at t_k.
 
     The loop state i follows the demand (first-order lag); the motor carries, and the sensors
-    measure, i_m = i·φ_H − δ_H·tanh(ω_m/ω_H): the calibrated surrogate of the three-phase
-    hysteresis loop's own error, which grows with the phase unbalance (monitor-model.md §1).
+    measure, i_m = `loop_error`(i, …): the calibrated surrogate of the three-phase hysteresis
+    loop's own error, which grows with the phase unbalance (monitor-model.md §1).
     """
     n = theta_cmd.shape[0]
     record = aux.shape[0] > 0
@@ -129,9 +155,12 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     decay = math.exp(-dt / prm[TAU_I])
     g = dt / prm[L_EQ]
     p = prm[P]
-    # hysteresis-loop offset δ_H = δ_0 + δ_1·Σ(1 − N_x): the measured current trails by δ_H·tanh(ω_m/ω_H)
-    delta_H = prm[DELTA_0] + prm[DELTA_1] * (3.0 - prm[N_A] - prm[N_B] - prm[N_C])
-    inv_omega_H = 1.0 / prm[OMEGA_H]
+    # the loop's offset δ_H = δ_0 + δ_1·Σ_x (1 − N_x) + δ_U·|U|
+    offset_0 = (
+        prm[DELTA_0]
+        + prm[DELTA_1] * (3.0 - prm[N_A] - prm[N_B] - prm[N_C])
+        + prm[DELTA_U] * unbalance(prm[N_A], prm[N_B], prm[N_C])
+    )
     kz_cos = prm[K_E] * prm[ZETA] * math.cos(prm[PHI_E])
     kz_sin = prm[K_E] * prm[ZETA] * math.sin(prm[PHI_E])
     theta_m = 0.0
@@ -167,9 +196,10 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
                 i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
             )
             # the current the motor carries and the sensors measure: the loop's surrogate error on top
-            i_m = i * phi_hyst(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_H]) - delta_H * math.tanh(
-                omega_m * inv_omega_H
-            )
+            c2 = unbalance_2(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C])
+            i_m = loop_error(
+                i, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
+            )  # fmt: skip
             T_m = prm[K_T_EQ] * f_sc * f_ecc * i_m
             theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp)
             acc_i += i_m

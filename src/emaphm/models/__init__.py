@@ -49,6 +49,7 @@ def simulate(
     command: Command | None = None,
     duration: float | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
 ) -> SimResult:
     """Simulate the EMA with fault vector `faults` (DESIGN §8).
 
@@ -67,8 +68,10 @@ def simulate(
         Override the nominal parameters, the FDI chirp, or its duration [s].
     calibration : Calibration or path, optional
         The monitor model's calibration (``model="lf"`` only; the packaged one by default).
+    monitor : {"default", "paper"}, optional
+        Which monitor model (``model="lf"`` only): see `MonitorEma`.
     """
-    ema = make_model(model, params=params, command=command, calibration=calibration)
+    ema = make_model(model, params=params, command=command, calibration=calibration, monitor=monitor)
     return ema.simulate(faults, noise=noise, seed=seed, duration=duration)
 
 
@@ -78,12 +81,16 @@ def make_model(
     params: EmaParams | None = None,
     command: Command | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
 ) -> HighFidelityEma | MonitorEma:
-    """The model named `model` ("hf" or "lf"); `calibration` only for the monitor (`InputError` else)."""
+    """The model named `model` ("hf" or "lf"); `calibration` and `monitor` only for the monitor
+    model (`InputError` else)."""
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; available: {', '.join(MODELS)}")
     if model == "lf":
-        return MonitorEma(params, command, calibration)
+        return MonitorEma(params, command, calibration, monitor=monitor)
     if calibration is not None:
         raise InputError("a calibration applies to the monitor model only (--model lf, model='lf')")
+    if monitor is not None:
+        raise InputError("a monitor choice applies to the monitor model only (--model lf, model='lf')")
     return HighFidelityEma(params, command)

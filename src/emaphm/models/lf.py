@@ -10,8 +10,9 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..calibration import Calibration, Coefficients, default_calibration, load_calibration
+from ..calibration import Calibration, Coefficients, check_monitor, default_calibration, load_calibration
 from ..commands import Command
+from ..errors import InputError
 from ..faults import HEALTHY, as_fault_matrix, as_fault_vector, fault_parameter_columns
 from ..kernels.monitor import AUX_COLUMNS, IDX, N_AUX, N_FIELDS, simulate_lf, simulate_lf_many
 from ..kernels.sensors import adc
@@ -22,13 +23,22 @@ from ._base import _EmaModel, check_finite, check_seed
 __all__ = ["MonitorEma", "monitor_rows", "resolve_calibration"]
 
 
-def resolve_calibration(calibration: Calibration | str | os.PathLike[str] | None) -> Calibration:
-    """A `Calibration` from itself, a calibration file's path, or None (the packaged one)."""
+def resolve_calibration(
+    calibration: Calibration | str | os.PathLike[str] | None, monitor: str | None = None
+) -> Calibration:
+    """A `Calibration` from itself, a calibration file's path, or None (the packaged one of `monitor`).
+
+    `monitor` ("default" or "paper") picks the packaged calibration; given with a calibration, it
+    must be the monitor that calibration was made for (`InputError` otherwise).
+    """
+    if monitor is not None:
+        check_monitor(monitor)
     if calibration is None:
-        return default_calibration()
-    if isinstance(calibration, Calibration):
-        return calibration
-    return load_calibration(calibration)
+        return default_calibration(monitor or "default")
+    cal = calibration if isinstance(calibration, Calibration) else load_calibration(calibration)
+    if monitor is not None and cal.monitor != monitor:
+        raise InputError(f"the calibration is for the {cal.monitor!r} monitor, not {monitor!r}")
+    return cal
 
 
 def monitor_rows(
@@ -61,7 +71,8 @@ def monitor_rows(
         "k_e_eq": [x.k_e_eq for x in coefficients], "J": [x.J_eq for x in coefficients],
         "tau_i": [x.tau_i for x in coefficients], "k_H": [x.k_H for x in coefficients],
         "delta_0": [x.delta_0 for x in coefficients], "delta_1": [x.delta_1 for x in coefficients],
-        "omega_H": [x.omega_H for x in coefficients],
+        "delta_u": [x.delta_u for x in coefficients], "delta_2": [x.delta_2 for x in coefficients],
+        "V_H": [x.V_H for x in coefficients],
     }  # fmt: skip
     for name, per_row in cal.items():
         rows[:, IDX[name]] = per_row
@@ -82,6 +93,10 @@ class MonitorEma(_EmaModel):
         ``emaphm calibrate``, or None for the packaged calibration. A calibration belongs to one
         actuator: one made for other parameters raises `InputError` unless
         ``allow_mismatch=True``.
+    monitor : {"default", "paper"}, optional
+        The monitor model: "default" (the single-phase model with its loop-error surrogate,
+        calibrated over multi-fault actuators and several commands) or "paper" (the paper's
+        model, eqs. 1–2 alone, calibrated on the paper's scenarios). None: the calibration's.
     """
 
     model = "lf"
@@ -92,10 +107,12 @@ class MonitorEma(_EmaModel):
         command: Command | None = None,
         calibration: Calibration | str | os.PathLike[str] | None = None,
         *,
+        monitor: str | None = None,
         allow_mismatch: bool = False,
     ) -> None:
         super().__init__(params, command)
-        self.calibration = resolve_calibration(calibration)
+        self.calibration = resolve_calibration(calibration, monitor)
+        self.monitor = self.calibration.monitor
         if not allow_mismatch:
             where = (
                 "the packaged calibration"
@@ -162,5 +179,8 @@ class MonitorEma(_EmaModel):
             "omega_m": col["omega_m"], "i_q_ref": col["i_q_ref"], "T_m": col["T_m"], "theta_u_true": col["theta_u"],
         }  # fmt: skip
         cal = self.calibration
-        extra = {"calibration": {**cal.to_json(), "coefficients": dataclasses.asdict(cal.coefficients)}}
+        extra = {
+            "monitor": self.monitor,
+            "calibration": {**cal.to_json(), "coefficients": dataclasses.asdict(cal.coefficients)},
+        }
         return SimResult(t=t, signals=signals, metadata=self.metadata(k, seed, noise, t, **extra))
