@@ -32,10 +32,11 @@ import time
 import numpy as np
 
 import emaphm
+from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS
-from emaphm.identification.fitness import Fitness
+from emaphm.identification.identify import FaultIdentifier
 from emaphm.models import HighFidelityEma, MonitorEma
 
 
@@ -45,10 +46,11 @@ def noise_seed_of(seed: int) -> int:
 
 
 def fitness_at(trace: emaphm.SimResult, K: np.ndarray, monitor: MonitorEma) -> np.ndarray:
-    """Eq. (3) fitness of fault rows K on a measured trace (the identification's objective)."""
-    grid, _ = monitor.sample_grid(min(float(trace.t[-1] - trace.t[0]), monitor.command.duration))
-    ref = Comparison.from_trace(trace.t - trace.t[0], trace.i_q, grid, monitor.params.controller.f_s)
-    return Fitness(ref, "s")(monitor.simulate_many(K, duration=float(grid[-1])))
+    """Eq. (3) fitness of fault rows K on a measured trace: the identification's own objective
+    (the same grid, filter and compared samples, `FaultIdentifier.prepare`)."""
+    command = SampledCommand(trace.t - trace.t[0], trace.theta_cmd)
+    ident = FaultIdentifier("ga", monitor=monitor).prepare(trace.t, trace.i_q, command, trace.theta_u)
+    return ident.objective_.of_monitor(ident.monitor_, K, duration=ident.duration_)
 
 
 def main() -> None:

@@ -81,6 +81,7 @@ def main() -> None:
     if args.write:
         record = {
             "thresholds": thresholds,
+            "monitor": "default",  # identify() warns when another monitor uses these thresholds
             "rule": "1.25 x the largest healthy departure + 0.005 (k1..k6 from 0, k8 from 0.5)",
             "optimizer": args.optimizer,
             "threshold_seeds": [1000, 1000 + args.runs - 1],

@@ -257,3 +257,12 @@ def test_the_monitor_is_chosen_by_name_on_the_command_line(tmp_path, capsys):
         target = tmp_path / "x.h5"
         code, _, err = run_cli(["simulate", *args, "--duration", "0.05", "--output", str(target)], capsys)
         assert code == 2 and message in err and not target.exists()
+
+
+def test_calibrate_and_identify_refuse_an_unknown_monitor_before_any_work(tmp_path, capsys):
+    out = tmp_path / "cal.json"
+    code, _, err = run_cli(["calibrate", "--monitor", "exact", "--output", str(out)], capsys)
+    assert code == 2 and "unknown monitor 'exact'" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+    code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--monitor", "exact"], capsys)
+    assert code == 2 and "unknown monitor 'exact'" in err

@@ -74,8 +74,12 @@ def test_new_commands_round_trip_through_their_record():
 
 
 def test_bad_new_commands():
-    with pytest.raises(InputError, match="levels"):
-        Steps(levels=())
+    for levels in ((), None, 5, (0.1, True), ("a",)):
+        with pytest.raises(InputError, match=r"Steps\.levels must be a non-empty list"):
+            Steps(levels=levels)
+    assert Steps(levels=np.array([0.01, -0.02])).levels == (0.01, -0.02)  # numpy values are numbers
+    with pytest.raises(InputError, match="at least its ramp"):
+        ChirpHold(hold=0.01, ramp=0.05)
     with pytest.raises(InputError, match="levels"):
         make_command("steps", levels=[0.0, float("nan")])
     with pytest.raises(InputError, match="dwell"):

@@ -8,7 +8,14 @@ import pytest
 
 import emaphm
 from emaphm import InputError, MonitorEma
-from emaphm.calibration import Calibration, Coefficients, default_calibration, load_calibration, params_hash
+from emaphm.calibration import (
+    SURROGATE,
+    Calibration,
+    Coefficients,
+    default_calibration,
+    load_calibration,
+    params_hash,
+)
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import (
     CALIBRATION_COMMANDS,
@@ -41,7 +48,7 @@ def test_held_out_scenarios_are_not_fitted():
 def test_the_paper_monitor_is_the_same_model_without_its_loop_surrogate():
     paper = MonitorEma(monitor="paper")
     c = paper.calibration.coefficients
-    assert paper.monitor == "paper" and (c.k_H, c.delta_0, c.delta_1, c.delta_2) == (0.0, 0.0, 0.0, 0.0)
+    assert paper.monitor == "paper" and all(getattr(c, n) == 0.0 for n in SURROGATE)
     assert MonitorEma().monitor == "default" and MonitorEma().calibration.coefficients.delta_0 > 0
     assert paper.calibration.record["settings"]["fitted"] == [
         "k_FS",
@@ -197,6 +204,32 @@ def test_a_paper_calibration_fits_only_the_papers_coefficients():
         check=PAPER_CHECK_SCENARIOS[:1],
     )
     c = cal.coefficients
-    assert cal.monitor == "paper" and (c.k_H, c.delta_0, c.delta_1, c.delta_2) == (0.0, 0.0, 0.0, 0.0)
+    assert cal.monitor == "paper" and all(getattr(c, n) == 0.0 for n in SURROGATE)
     with pytest.raises(InputError, match="unknown monitor"):
         calibrate(monitor="other", pop_size=6, generations=1)
+
+
+def test_a_calibration_file_must_say_a_known_monitor_and_a_paper_one_has_no_surrogate(tmp_path):
+    data = default_calibration("paper").to_json()
+    for bad, match in (([1], "unknown monitor"), ("three-phase", "unknown monitor")):
+        (tmp_path / "c.json").write_text(json.dumps({**data, "monitor": bad}))
+        with pytest.raises(InputError, match=match):
+            load_calibration(tmp_path / "c.json")
+    data["coefficients"]["delta_0"] = 0.01
+    (tmp_path / "c.json").write_text(json.dumps(data))
+    with pytest.raises(InputError, match="has no loop surrogate"):
+        load_calibration(tmp_path / "c.json")
+
+
+def test_a_calibration_can_name_its_own_commands():
+    from emaphm.commands import Sine
+    from emaphm.identification.calibrate import Scenario
+
+    rig = {"rig": Sine(amplitude=0.01, frequency=3.0, duration=0.3)}
+    fit = [Scenario("healthy on the rig", emaphm.HEALTHY, "rig")]
+    cal = calibrate(seed=2, pop_size=4, generations=1, fit=fit, check=fit, commands=rig)
+    assert list(cal.commands()) == ["rig"] and cal.commands()["rig"] == rig["rig"]
+    with pytest.raises(InputError, match="unknown command 'rig'"):
+        calibrate(pop_size=4, generations=1, fit=fit, check=[])
+    with pytest.raises(InputError, match="at least one fitting scenario"):
+        calibrate(pop_size=4, generations=1, fit=[], check=[], commands=rig)

@@ -8,7 +8,7 @@ The public API:
   (DESIGN §4); `EmaParams` and its groups hold the parameters;
 - `FAULT_NAMES`, `HEALTHY`, `TABLE1_REFERENCE`, `as_fault_vector`, `apply_faults` define the
   fault vector k1..k8 (DESIGN §2);
-- `Chirp`, `Step`, `Ramp`, `Sine` are position commands;
+- `Chirp`, `ChirpHold`, `Steps`, `Step`, `Ramp`, `Sine` are position commands;
 - `read_trace` / `write_trace` store traces as HDF5 or CSV;
 - `identify` / `FaultIdentifier` find the fault vector from a measured current (DESIGN §5) and
   `percent_error` scores it (paper eq. 4, the reading that reproduces Table 1);
@@ -28,7 +28,7 @@ from .errors import InputError, SimulationError
 
 # public name -> module that defines it
 _LAZY = {
-    "Chirp": "commands", "Ramp": "commands", "Sine": "commands", "Step": "commands",
+    "Chirp": "commands", "ChirpHold": "commands", "Steps": "commands", "Ramp": "commands", "Sine": "commands", "Step": "commands",
     "make_command": "commands",
     "FAULT_NAMES": "faults", "HEALTHY": "faults", "TABLE1_REFERENCE": "faults",
     "apply_faults": "faults", "as_fault_vector": "faults",
@@ -52,6 +52,7 @@ __all__ = [
     "TABLE1_REFERENCE",
     "Calibration",
     "Chirp",
+    "ChirpHold",
     "ControllerParams",
     "EmaParams",
     "FaultIdentifier",
@@ -68,6 +69,7 @@ __all__ = [
     "SimulationError",
     "Sine",
     "Step",
+    "Steps",
     "TransmissionParams",
     "__version__",
     "absolute_errors",
@@ -100,7 +102,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from .calibration import Calibration, load_calibration
-    from .commands import Chirp, Ramp, Sine, Step, make_command
+    from .commands import Chirp, ChirpHold, Ramp, Sine, Step, Steps, make_command
     from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
     from .identification.calibrate import calibrate
     from .identification.detection import detect

@@ -254,10 +254,9 @@ def _parse(data: Any, where: str) -> Calibration:
                 else ""
             )
         )
-    if data.get("monitor", "default") not in MONITOR_FILES:
-        raise InputError(
-            f"{where}: unknown monitor {data.get('monitor')!r}; expected one of {', '.join(MONITOR_FILES)}"
-        )
+    monitor = data.get("monitor", "default")
+    if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
+        raise InputError(f"{where}: unknown monitor {monitor!r}; expected one of {', '.join(MONITOR_FILES)}")
     coeffs = data.get("coefficients")
     if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
         raise InputError(f"{where}: coefficients must be exactly {', '.join(COEFFICIENT_BOUNDS)}")
@@ -273,6 +272,10 @@ def _parse(data: Any, where: str) -> Calibration:
         cal = Calibration(Coefficients(**coeffs), n_lf, record)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
+    if monitor == "paper" and any(getattr(cal.coefficients, n) != 0.0 for n in SURROGATE):
+        raise InputError(
+            f"{where}: a 'paper' monitor has no loop surrogate, but {', '.join(SURROGATE)} are not all 0"
+        )
     stored = data.get("params_hash")
     if stored is not None and stored != cal.params_hash:
         raise InputError(f"{where}: params_hash {stored!r} does not match the recorded parameters")
@@ -296,9 +299,14 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
 MONITOR_FILES = {"default": "calibration.json", "paper": "calibration-paper.json"}
 
 
-def check_monitor(monitor: str) -> str:
+# the loop-error surrogate's coefficients that the paper's monitor holds at zero (V_H, a scale,
+# has no effect then)
+SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2")
+
+
+def check_monitor(monitor: Any) -> str:
     """`monitor` if it names a packaged monitor model, else `InputError`."""
-    if monitor not in MONITOR_FILES:
+    if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
         raise InputError(f"unknown monitor {monitor!r}; choose one of {', '.join(MONITOR_FILES)}")
     return monitor
 

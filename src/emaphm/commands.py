@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -47,7 +48,7 @@ class _Checked:
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             v = getattr(self, f.name)
-            if isinstance(v, (tuple, list)):  # a sequence field: its class checks it
+            if f.name == "levels":  # a sequence field: its class checks it
                 continue
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise InputError(f"{type(self).__name__}.{f.name} must be a finite number, got {v!r}")
@@ -104,6 +105,11 @@ class ChirpHold(Chirp):
     hold: float = 1.0
     ramp: float = 0.05
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.hold < self.ramp:
+            raise InputError(f"ChirpHold.hold ({self.hold!r} s) must be at least its ramp ({self.ramp!r} s)")
+
     @property
     def duration(self) -> float:
         return self.T + self.hold
@@ -124,8 +130,13 @@ class Steps(_Checked):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        levels = tuple(self.levels)
-        if not levels or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in levels):
+        try:
+            levels = tuple(self.levels)
+        except TypeError:
+            levels = ()
+        if not levels or not all(
+            isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in levels
+        ):
             raise InputError(f"Steps.levels must be a non-empty list of finite numbers, got {self.levels!r}")
         object.__setattr__(self, "levels", tuple(float(v) for v in levels))
 

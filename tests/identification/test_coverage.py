@@ -94,3 +94,33 @@ def test_a_chirp_with_a_hold_is_covered_and_its_held_samples_are_left_out():
     # against friction (measured: 0.64 of the samples kept by the true position, 0.70 by the
     # measured one with its noise); the command alone would keep 0.55
     assert 0.55 < r.settings["samples_compared"] < 0.8
+
+
+def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are_flagged():
+    t = np.arange(5001) / 1e4
+    rest = emaphm.SimResult(
+        t=t,
+        signals={"theta_cmd": np.zeros_like(t), "theta_u": np.zeros_like(t), "i_q": np.zeros_like(t) + 1e-3},
+        metadata={},
+    )
+    r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
+    assert r.settings["samples_compared"] < 0.15  # the first 50 ms of the 0.5 s
+    assert any("of the recording is compared" in w for w in r.warnings)
+    r = emaphm.identify(
+        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False, monitor="paper"
+    )
+    assert any("thresholds were measured with the 'default' monitor" in w for w in r.warnings)
+    r = emaphm.identify(
+        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False, monitor="paper",
+        thresholds={},
+    )  # fmt: skip
+    assert not any("thresholds" in w for w in r.warnings)
+
+
+def test_a_staircase_logged_one_sample_late_is_still_the_calibrated_one():
+    from emaphm.commands import Steps
+
+    t = np.arange(20001) / 1e4
+    late = Steps()(np.clip(t - 1e-4, 0, None))
+    assert command_warnings(t, late, CAL) == []
+    assert command_warnings(t, Steps()(np.clip(t - 1e-2, 0, None)), CAL) != []  # 10 ms is another command

@@ -83,9 +83,13 @@ def test_the_moving_mask_leaves_out_only_a_long_hold_where_the_surface_rests():
     np.testing.assert_array_equal(moving_mask(hold, f_s, theta_u=at_rest), m)
     kept = moving_mask(hold, f_s, theta_u=creeping)
     assert np.all(kept[t > 1.3] == 1.0) and np.all(kept[(t > 1.11) & (t < 1.2)] == 0.0)
-    # steps of 0.2 s: held after 50 ms where the surface rests, never while it moves
+    # steps of 0.2 s: without a position, dwells shorter than LONG_HOLD_S stay whole (the surface
+    # hunts through them); with it, a dwell is cut only where the surface rests
     steps = Steps(dwell=0.2)(t)
-    assert 0.2 < moving_mask(steps, f_s).mean() < 0.3
+    assert np.all(moving_mask(steps, f_s) == 1.0)
+    hunting = 3 * REST_BAND * np.sin(2 * np.pi * 20 * t)
+    assert np.all(moving_mask(steps, f_s, theta_u=hunting) == 1.0)
+    assert 0.2 < moving_mask(steps, f_s, theta_u=np.zeros_like(t)).mean() < 0.3
 
 
 def test_a_masked_fitness_ignores_the_left_out_samples():

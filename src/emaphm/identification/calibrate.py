@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +22,7 @@ from pymoo.algorithms.soo.nonconvex.ga import GA
 
 from .._version import __version__
 from .._versions import versions
-from ..calibration import COEFFICIENT_BOUNDS, Calibration, Coefficients
+from ..calibration import COEFFICIENT_BOUNDS, SURROGATE, Calibration, Coefficients, check_monitor
 from ..commands import Chirp, ChirpHold, Command, Steps, command_record
 from ..errors import InputError
 from ..faults import HEALTHY, as_fault_vector, random_faults
@@ -36,7 +36,6 @@ __all__ = [
     "CALIBRATION_COMMANDS",
     "CHECK_SCENARIOS",
     "FIT_SCENARIOS",
-    "MONITORS",
     "PAPER_CHECK_SCENARIOS",
     "PAPER_FIT_SCENARIOS",
     "Scenario",
@@ -56,12 +55,11 @@ CALIBRATION_COMMANDS: dict[str, Command] = {
     "steps": Steps(),
 }
 
-MONITORS = ("default", "paper")
-
 
 @dataclass(frozen=True)
 class Scenario:
-    """A named fault vector the HF twin is run with, under one of `CALIBRATION_COMMANDS`."""
+    """A named fault vector the HF twin is run with, under the command named `command` (a key of
+    the `commands` given to `calibrate`, `CALIBRATION_COMMANDS` by default)."""
 
     name: str
     faults: tuple[float, ...]
@@ -69,11 +67,6 @@ class Scenario:
 
     def __post_init__(self) -> None:
         as_fault_vector(self.faults, name=f"scenario {self.name!r}")
-        if self.command not in CALIBRATION_COMMANDS:
-            raise InputError(
-                f"scenario {self.name!r}: unknown command {self.command!r}; "
-                f"choose one of {', '.join(CALIBRATION_COMMANDS)}"
-            )
 
 
 def _k(**changes: float) -> tuple[float, ...]:
@@ -166,9 +159,10 @@ def hf_references(
     noise: bool,
     seed: int,
     progress: Progress | None = None,
+    commands: Mapping[str, Command] = CALIBRATION_COMMANDS,
 ) -> list[Comparison]:
     """Filtered HF i_q of each scenario on the sample grid of its command."""
-    twins = {c: HighFidelityEma(params, CALIBRATION_COMMANDS[c]) for c in {sc.command for sc in scenarios}}
+    twins = {c: HighFidelityEma(params, commands[c]) for c in {sc.command for sc in scenarios}}
     out = []
     for j, sc in enumerate(scenarios):
         r = twins[sc.command].simulate(sc.faults, noise=noise, seed=seed)
@@ -184,6 +178,7 @@ def scenario_nrmse(
     references: Sequence[Comparison],
     params: EmaParams,
     n_lf: int,
+    commands: Mapping[str, Command] = CALIBRATION_COMMANDS,
 ) -> NDArray[np.float64]:
     """NRMSE of the LF model per (coefficient set, scenario): shape (len(coefficients), len(scenarios)).
 
@@ -193,7 +188,7 @@ def scenario_nrmse(
     out = np.empty((n_c, len(scenarios)))
     for command in dict.fromkeys(sc.command for sc in scenarios):
         which = [j for j, sc in enumerate(scenarios) if sc.command == command]
-        _, theta_cmd = HighFidelityEma(params, CALIBRATION_COMMANDS[command]).sample_grid()
+        _, theta_cmd = HighFidelityEma(params, commands[command]).sample_grid()
         K = np.array([scenarios[j].faults for j in which])
         n_s = len(which)
         rows = monitor_rows(np.tile(K, (n_c, 1)), params, [c for c in coefficients for _ in range(n_s)], n_lf)
@@ -203,9 +198,6 @@ def scenario_nrmse(
         for s, j in enumerate(which):
             out[:, j] = references[j].nrmse(by_case[:, s, :])
     return out
-
-
-SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "V_H")  # the paper's monitor has none
 
 
 def calibrate(
@@ -218,6 +210,7 @@ def calibrate(
     params: EmaParams | None = None,
     fit: Sequence[Scenario] | None = None,
     check: Sequence[Scenario] | None = None,
+    commands: Mapping[str, Command] | None = None,
     progress: Progress | None = None,
 ) -> Calibration:
     """Fit the LF coefficients to the HF twin and check them on held-out scenarios.
@@ -229,10 +222,13 @@ def calibrate(
     twin's deterministic response); the held-out check is also reported with noise on (seed
     `seed`). Returns a `Calibration` whose record holds the monitor, the scenario sets, the
     NRMSE of each, the seed, the settings, the GA history and the versions.
+
+    `commands` names the commands the scenarios refer to (`CALIBRATION_COMMANDS` by default):
+    e.g. ``commands={"rig": SampledCommand(t, theta)}`` with scenarios whose command is "rig"
+    calibrates the monitor for a rig's own manoeuvre.
     """
     seed = check_seed(seed)
-    if monitor not in MONITORS:
-        raise InputError(f"unknown monitor {monitor!r}; choose one of {', '.join(MONITORS)}")
+    check_monitor(monitor)
     for name, value, least in (("pop_size", pop_size, 4), ("generations", generations, 1), ("n_lf", n_lf, 1)):
         if not isinstance(value, int) or value < least:
             raise InputError(f"{name} must be a whole number >= {least}, got {value!r}")
@@ -240,19 +236,31 @@ def calibrate(
     fit = tuple(fit if fit is not None else PAPER_FIT_SCENARIOS if paper else FIT_SCENARIOS)
     check = tuple(check if check is not None else PAPER_CHECK_SCENARIOS if paper else CHECK_SCENARIOS)
     params = params if params is not None else EmaParams()
+    commands = dict(commands if commands is not None else CALIBRATION_COMMANDS)
+    if not fit:
+        raise InputError("calibration needs at least one fitting scenario")
+    for sc in fit + check:
+        if sc.command not in commands:
+            raise InputError(
+                f"scenario {sc.name!r}: unknown command {sc.command!r}; choose one of {', '.join(commands)}"
+            )
     start = time.perf_counter()
-    fit_refs = hf_references(fit, params, noise=False, seed=seed, progress=progress)
-    check_refs = hf_references(check, params, noise=False, seed=seed, progress=progress)
-    check_refs_noisy = hf_references(check, params, noise=True, seed=seed, progress=progress)
+    fit_refs = hf_references(fit, params, noise=False, seed=seed, progress=progress, commands=commands)
+    check_refs = hf_references(check, params, noise=False, seed=seed, progress=progress, commands=commands)
+    check_refs_noisy = hf_references(
+        check, params, noise=True, seed=seed, progress=progress, commands=commands
+    )
     # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
-    free = [n for n in COEFFICIENT_BOUNDS if not (paper and n in SURROGATE)]
+    free = [n for n in COEFFICIENT_BOUNDS if not (paper and (n in SURROGATE or n == "V_H"))]
     fixed = dataclasses.asdict(Coefficients())
 
     def coefficients(x: NDArray[np.float64]) -> Coefficients:
         return Coefficients(**{**fixed, **{n: float(v) for n, v in zip(free, x, strict=True)}})
 
     def objective(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        return scenario_nrmse([coefficients(x) for x in X], fit, fit_refs, params, n_lf).mean(axis=1)
+        return scenario_nrmse([coefficients(x) for x in X], fit, fit_refs, params, n_lf, commands).mean(
+            axis=1
+        )
 
     def on_generation(generation: int, total: int, best: float) -> None:
         if progress:
@@ -266,10 +274,12 @@ def calibrate(
         problem, GA(pop_size=pop_size), generations, seed=seed, on_generation=on_generation
     )
     best = coefficients(x)
-    fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf)[0]
-    check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf)[0]
-    check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf)[0]
-    start_nrmse = scenario_nrmse([Coefficients()], fit + check, fit_refs + check_refs, params, n_lf)[0]
+    fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands)[0]
+    check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands)[0]
+    check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf, commands)[0]
+    start_nrmse = scenario_nrmse(
+        [Coefficients()], fit + check, fit_refs + check_refs, params, n_lf, commands
+    )[0]
 
     def table(scenarios: Sequence[Scenario], values: NDArray[np.float64]) -> list[dict[str, Any]]:
         return [
@@ -299,8 +309,8 @@ def calibrate(
             "bounds": {k: list(v) for k, v in COEFFICIENT_BOUNDS.items()},
             "fitted": free,
             # the first is the main one (the FDI chirp); every command fitted or checked is listed
-            "command": command_record(CALIBRATION_COMMANDS[next(iter(used))]),
-            "commands": {c: command_record(CALIBRATION_COMMANDS[c]) for c in used},
+            "command": command_record(commands[next(iter(used))]),
+            "commands": {c: command_record(commands[c]) for c in used},
             "params": params.to_dict(),
             "wall_time_s": round(time.perf_counter() - start, 2),
         },

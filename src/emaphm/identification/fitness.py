@@ -31,13 +31,16 @@ from .signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 if TYPE_CHECKING:
     from ..models import MonitorEma
 
-__all__ = ["HOLD_SETTLE_S", "REST_BAND", "SLOPE_UNITS", "Fitness", "moving_mask"]
+__all__ = ["HOLD_SETTLE_S", "LONG_HOLD_S", "REST_BAND", "SLOPE_UNITS", "Fitness", "moving_mask"]
 
 SLOPE_UNITS = {"s": 1.0, "ms": 1e-3}  # the slope in A per this unit of time
 
 # a hold of the command counts for this long after the command stops (the surface settles)
 HOLD_SETTLE_S = 0.05
 
+
+# without a measured position, only holds of the command longer than this count as rests
+LONG_HOLD_S = 0.5
 
 # the surface counts as at rest while its measured position stays within this band [rad]: 10 LSB
 # of the 16-bit ±0.3 rad position sensor, 10 σ of its noise (DESIGN §7)
@@ -52,9 +55,11 @@ def moving_mask(
 ) -> NDArray[np.float64]:
     """0 on the samples of a long hold where the surface is stuck, 1 everywhere else.
 
-    A sample is left out when the command has not moved for more than `settle` [s] and, if the
-    measured surface position `theta_u` [rad] is given, the surface has stayed within `REST_BAND`
-    over that time too. There the surface sits wherever stick-slip left it, and the position
+    A sample is left out when the command has not moved for more than `settle` [s] and the
+    measured surface position `theta_u` [rad] has stayed within `REST_BAND` over that time too.
+    Without `theta_u` the rest of the surface is unknown: then only the holds of the command
+    longer than `LONG_HOLD_S` in all are taken as rests (after `settle`), so that the 0.2 s
+    dwells of a staircase, where the surface keeps hunting, stay whole. There the surface sits wherever stick-slip left it, and the position
     loop's integrator ramps the current against that small error: the held current depends on the
     sticking point, not on the faults. On the chirp followed by a hold it differed by 30-37 mA RMS
     between the twin and the monitor at the true faults, against 16 mA over the chirp, and it drove
@@ -71,7 +76,10 @@ def moving_mask(
     still[1:] = np.abs(np.diff(theta)) <= 1e-9 * max(peak, 1e-12)
     last_move = np.maximum.accumulate(np.where(still, 0, idx))  # the last sample the command moved
     held = still & (idx - last_move > window)
-    if theta_u is not None:
+    if theta_u is None:
+        next_move = np.minimum.accumulate(np.where(still, n, idx)[::-1])[::-1]  # the next sample it moves
+        held &= (next_move - last_move) / f_s > LONG_HOLD_S
+    else:
         pos = np.asarray(theta_u, dtype=np.float64)
         if pos.shape != theta.shape:
             raise ValueError(f"theta_u has shape {pos.shape}, theta_cmd {theta.shape}")

@@ -29,14 +29,15 @@ from ..io import read_trace
 from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..results import SimResult
 from .coverage import command_warnings
-from .detection import detect
+from .detection import detect, load_thresholds
 from .fitness import Fitness, moving_mask
 from .metrics import absolute_errors, percent_error
 from .optimizers import OnGeneration, OptimizerRun, Stagnation, check_optimizer, polish, run_optimizer
-from .signals import Comparison
+from .signals import Comparison, nrmse
 
 __all__ = [
     "FIT_NRMSE_LIMIT",
+    "MIN_COMPARED",
     "MIN_SAMPLES",
     "MIN_SPAN",
     "FaultIdentifier",
@@ -46,6 +47,8 @@ __all__ = [
 ]
 
 MIN_SAMPLES = 200  # a reference shorter than this (20 ms at 10 kHz) cannot show the faults
+# below this fraction of samples compared (the rest a rest in a hold), a result carries a warning
+MIN_COMPARED = 0.3
 # a diagnosis needs this much of the FDI command: on the Table 1 case (benchmarks, noise seed 7)
 # the first 0.1 s gave 31.7 %err (friction missed, a spurious eccentricity) while fitting to 3.9 %
 # NRMSE, 0.2 s 5.4 %err, 0.3 s and 0.5 s 3.4 %err
@@ -175,19 +178,21 @@ class FaultIdentifier:
         self.monitor = monitor
         self.on_generation = on_generation
 
-    def fit(
+    def prepare(
         self,
         t: ArrayLike,
         i_q: ArrayLike,
         command: Command | None = None,
         theta_u: ArrayLike | None = None,
     ) -> FaultIdentifier:
-        """Fit to the current i_q [A] sampled at t [s] under `command` (default: the FDI chirp).
+        """Check the measurement and set up what the search compares (`fit` calls it first).
 
-        `theta_u` [rad], the measured surface position at t if the trace has it, tells where the
-        surface is at rest in a hold of the command (`fitness.moving_mask`).
+        Sets `monitor_` (the monitor under the measurement's command), `duration_` [s],
+        `reference_` (the filtered measurement on the model grid), `mask_` (the samples compared,
+        `fitness.moving_mask`), `compared_` (their fraction) and `objective_` (eq. 3 over them):
+        ``objective_.of_monitor(monitor_, K, duration=duration_)`` scores fault rows K exactly as
+        the search does.
         """
-        seed = check_seed(self.seed)
         t = np.asarray(t, dtype=np.float64)
         i_q = np.asarray(i_q, dtype=np.float64)
         if t.ndim != 1 or t.shape != i_q.shape:
@@ -210,19 +215,37 @@ class FaultIdentifier:
             allow_mismatch=True,
         )  # base was checked when it was built
         duration = min(span, monitor.command.duration)
-        grid, _ = monitor.sample_grid(duration)
-        reference = Comparison.from_trace(t - t[0], i_q, grid, monitor.params.controller.f_s)
-        # long holds of the command are left out (`moving_mask`): the held current is not the faults'
-        _, theta_grid = monitor.sample_grid(duration)
+        grid, theta_grid = monitor.sample_grid(duration)
+        f_s = monitor.params.controller.f_s
+        reference = Comparison.from_trace(t - t[0], i_q, grid, f_s)
+        # long holds where the surface rests are left out (`moving_mask`): that current is not the faults'
         position = None
         if theta_u is not None:
             pos = np.asarray(theta_u, dtype=np.float64)
             if pos.shape != t.shape or not np.all(np.isfinite(pos)):
                 raise InputError("theta_u must be finite and sampled at the reference's times")
             position = np.interp(grid, t - t[0], pos)
-        mask = moving_mask(theta_grid, monitor.params.controller.f_s, theta_u=position)
-        self.compared_ = float(mask.mean())
-        fitness = Fitness(reference, self.slope_unit, mask)
+        self.monitor_, self.duration_, self.reference_ = monitor, duration, reference
+        self.mask_ = moving_mask(theta_grid, f_s, theta_u=position)
+        self.compared_ = float(self.mask_.mean())
+        self.objective_ = Fitness(reference, self.slope_unit, self.mask_)
+        return self
+
+    def fit(
+        self,
+        t: ArrayLike,
+        i_q: ArrayLike,
+        command: Command | None = None,
+        theta_u: ArrayLike | None = None,
+    ) -> FaultIdentifier:
+        """Fit to the current i_q [A] sampled at t [s] under `command` (default: the FDI chirp).
+
+        `theta_u` [rad], the measured surface position at t if the trace has it, tells where the
+        surface is at rest in a hold of the command (`fitness.moving_mask`).
+        """
+        seed = check_seed(self.seed)
+        self.prepare(t, i_q, command, theta_u)
+        monitor, duration, fitness = self.monitor_, self.duration_, self.objective_
 
         def evaluate(X: NDArray[np.float64]) -> NDArray[np.float64]:
             # one parallel kernel call: simulation, filter and eq. (3) fused per row, the same numbers
@@ -241,10 +264,11 @@ class FaultIdentifier:
         self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
         self.fitness_ = run.f
         self.run_ = run
-        # how well the best LF current explains the measurement (both filtered), for the verdict
+        # how well the best LF current explains the compared samples (both filtered), for the verdict
         try:
-            best = monitor.simulate(self.faults_, duration=duration).i_q
-            self.fit_nrmse_ = float(reference.nrmse(best))
+            best = self.reference_.filtered(monitor.simulate(self.faults_, duration=duration).i_q)
+            keep = self.mask_ > 0
+            self.fit_nrmse_ = float(nrmse(self.reference_.reference[keep], best[keep]))
         except SimulationError:
             self.fit_nrmse_ = float("inf")
         return self
@@ -356,6 +380,17 @@ def identify(
         ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
     run = ident.run_
     warnings = command_warnings(trace.t, trace.theta_cmd, monitor_model.calibration)
+    if ident.compared_ < MIN_COMPARED:
+        warnings.append(
+            f"only {100 * ident.compared_:.0f} % of the recording is compared: the rest is a hold where "
+            "the surface rests, whose current does not depend on the faults; the diagnosis rests on little data"
+        )
+    limits_monitor = load_thresholds().get("monitor", "default") if thresholds is None else None
+    if limits_monitor is not None and limits_monitor != monitor_model.monitor:
+        warnings.append(
+            f"the detection thresholds were measured with the {limits_monitor!r} monitor, not the "
+            f"{monitor_model.monitor!r} one: faults near them may be reported wrongly"
+        )
     fits = explains(ident.fit_nrmse_)
     if not fits:
         warnings.append(
