@@ -54,3 +54,15 @@ def test_non_finite_permutations_are_never_taken():
     run = OptimizerRun(wrong, float(bowl(wrong)[0]), 0, [])
     out, order = try_short_permutations(nan_elsewhere, run, polish_it=False)
     assert order is None and out.f == run.f
+
+
+def test_the_phase_is_moved_off_a_bound_of_the_box_without_changing_the_faults():
+    from emaphm.identification.identify import recentre_phase, search_to_faults
+
+    for x7 in (0.0, 0.1, 0.3, 0.5, 0.74, 0.9, 1.0):
+        x = TRUTH.copy()
+        x[6] = x7
+        out = recentre_phase(OptimizerRun(x, 0.5, 7, [1.0]))
+        assert 0.25 <= out.x[6] < 0.75 and (out.f, out.evaluations, out.history) == (0.5, 7, [1.0])
+        np.testing.assert_allclose(search_to_faults(out.x[None]), search_to_faults(x[None]), atol=1e-12)
+        np.testing.assert_array_equal(np.delete(out.x, 6), np.delete(x, 6))
