@@ -22,13 +22,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import time
 from collections.abc import Callable
 
 import numba
 import numpy as np
+from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
 from emaphm._versions import versions
@@ -37,17 +37,6 @@ from emaphm.identification.fitness import Fitness
 from emaphm.identification.identify import search_to_faults
 from emaphm.identification.signals import Comparison
 from emaphm.models import MonitorEma
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def main() -> None:

@@ -33,6 +33,7 @@ import statistics
 import time
 
 import numpy as np
+from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
 from emaphm.commands import SampledCommand
@@ -74,9 +75,7 @@ def main() -> None:
     parser.add_argument("--pop-size", type=int, default=None, help="population of each search")
     parser.add_argument("--generations", type=int, default=None, help="generations of each search")
     args = parser.parse_args()
-    cpu = next(
-        (ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?"
-    )
+    cpu = cpu_model()
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
           f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
           f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}, "

@@ -21,6 +21,7 @@ import platform
 import time
 
 import numpy as np
+from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
 from emaphm.faults import random_faults
@@ -37,9 +38,7 @@ def main() -> None:
     parser.add_argument("--monitors", default="paper,default")
     parser.add_argument("--calibration", default=None, help="a calibration file, reported as 'file'")
     args = parser.parse_args()
-    cpu = next(
-        (ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?"
-    )
+    cpu = cpu_model()
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
           f"{args.cases} cases (seed {args.case_seed}), HF noise off")  # fmt: skip
     cases = random_faults(args.cases, args.case_seed)
