@@ -18,17 +18,17 @@ def test_shorts_in_the_wrong_phases_are_moved_to_the_right_ones():
     wrong = TRUTH.copy()
     wrong[2:5] = [0.4, 0.0, 0.05]  # the right magnitudes, the wrong phases
     run = OptimizerRun(wrong, float(bowl(wrong)[0]), 100, [1.0])
-    out, order = try_short_permutations(bowl, run, polish_it=False)
+    out, order, move = try_short_permutations(bowl, run, polish_it=False)
     np.testing.assert_array_equal(out.x, TRUTH)
-    assert out.f == 0.0 and out.evaluations == 105
+    assert out.f == 0.0 and out.evaluations == 108 and move == f"order {order}"
     assert [wrong[2 + o] for o in order] == list(TRUTH[2:5])
     assert out.history == [1.0]  # the optimiser's generations only
 
 
 def test_a_right_answer_is_kept_as_it_is():
     run = OptimizerRun(TRUTH.copy(), 0.0, 50, [0.0])
-    out, order = try_short_permutations(bowl, run, polish_it=False)
-    assert order is None and out.f == 0.0 and out.evaluations == 55
+    out, order, move = try_short_permutations(bowl, run, polish_it=False)
+    assert order is None and move is None and out.f == 0.0 and out.evaluations == 58
     np.testing.assert_array_equal(out.x, TRUTH)
 
 
@@ -37,8 +37,8 @@ def test_a_better_permutation_is_polished_when_asked():
     near[2:5] = [0.42, 0.0, 0.04]  # a permutation of nearly the right magnitudes
     near[0] = 0.25
     run = OptimizerRun(near, float(bowl(near)[0]), 0, [])
-    plain, _ = try_short_permutations(bowl, run, polish_it=False)
-    polished, order = try_short_permutations(bowl, run, seed=3, polish_it=True)
+    plain, _, _ = try_short_permutations(bowl, run, polish_it=False)
+    polished, order, _ = try_short_permutations(bowl, run, seed=3, polish_it=True)
     assert order is not None and polished.f < plain.f < run.f
     assert polished.evaluations > plain.evaluations
 
@@ -52,8 +52,17 @@ def test_non_finite_permutations_are_never_taken():
         return np.where(np.all(np.atleast_2d(X) == wrong, axis=1), f, np.nan)
 
     run = OptimizerRun(wrong, float(bowl(wrong)[0]), 0, [])
-    out, order = try_short_permutations(nan_elsewhere, run, polish_it=False)
-    assert order is None and out.f == run.f
+    out, order, move = try_short_permutations(nan_elsewhere, run, polish_it=False)
+    assert order is None and move is None and out.f == run.f
+
+
+def test_a_spurious_short_is_zeroed():
+    spurious = TRUTH.copy()
+    spurious[4] = 0.3  # the truth has no short in phase C
+    run = OptimizerRun(spurious, float(bowl(spurious)[0]), 10, [])
+    out, order, move = try_short_permutations(bowl, run, polish_it=False)
+    assert move == "k5 zeroed" and order is None and out.f == 0.0
+    np.testing.assert_array_equal(out.x, TRUTH)
 
 
 def test_the_phase_is_moved_off_a_bound_of_the_box_without_changing_the_faults():
