@@ -267,7 +267,9 @@ class FaultIdentifier:
         if self.local_polish:
             # from the representative of k7 inside the box: a polish cannot move a point at a bound
             run = polish(evaluate, recentre_phase(run), seed=seed, on_generation=self.on_generation)
-        run, self.permutation_, self.short_move_ = try_short_permutations(evaluate, run, seed=seed, polish_it=self.local_polish)
+        run, self.permutation_, self.short_move_ = try_short_permutations(
+            evaluate, run, seed=seed, polish_it=self.local_polish
+        )
         self.wall_time_ = time.perf_counter() - start
         self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
         self.fitness_ = run.f
