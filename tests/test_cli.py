@@ -108,11 +108,13 @@ def test_entry_point_is_installed():
 def test_cli_literals_match_the_code():
     # the CLI keeps these as literals so that it starts without numpy
     from emaphm import HEALTHY
-    from emaphm.cli import COMMAND_NAMES, HEALTHY_TEXT
+    from emaphm.cli import COMMAND_NAMES, HEALTHY_TEXT, UQ_METHOD_NAMES
     from emaphm.commands import COMMANDS
+    from emaphm.identification.uncertainty import UQ_METHODS
 
     assert [float(v) for v in HEALTHY_TEXT.split(",")] == list(HEALTHY)
     assert tuple(COMMAND_NAMES) == tuple(COMMANDS)
+    assert UQ_METHOD_NAMES == UQ_METHODS
 
 
 def test_cli_starts_without_the_numerical_stack():
@@ -197,6 +199,50 @@ def test_identify_json(tmp_path, capsys):
     assert set(data["settings"]["versions"]) >= {"emaphm", "numpy", "numba", "pymoo"}
     assert data["settings"]["calibration"]["params_hash"]
     assert json.loads(out.read_text())["estimate"] == data["estimate"]
+    # the uncertainty (issue 9): Laplace by default, calibrated by the packaged file
+    assert data["uq_method"] == "laplace" and data["settings"]["uq_calibration"]["calibrated"]
+    for key in ("std", "ci90_low", "ci90_high", "uq_flags"):
+        assert len(data[key]) == 8
+    assert len(data["corr"]) == 8 and all(len(row) == 8 for row in data["corr"])
+    for j in range(8):
+        if j != 6:
+            assert 0 <= data["ci90_low"][j] <= data["estimate"][j] <= data["ci90_high"][j] <= 1
+    # no eccentricity in the truth: its direction is flagged, its interval the whole circle
+    if "phase_undefined" in data["uq_flags"][6]:
+        assert (data["ci90_low"][6], data["ci90_high"][6]) == (0.0, 1.0) and data["std"][6] is None
+    assert set(data["fault_verdicts"]) == set(data["fault_names"]) - {"eccentricity_phase"}
+    assert data["detected"] == [n for n, v in data["fault_verdicts"].items() if v == "present"]
+
+
+def test_identify_without_uncertainty_gives_null_intervals(capsys):
+    import json
+
+    code, stdout, _ = run_cli(
+        ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--json", "--uncertainty", "none", *FAST], capsys
+    )
+    data = json.loads(stdout)
+    assert (
+        code == 0
+        and data["uq_method"] == "none"
+        and data["ci90_low"] is None
+        and data["fault_verdicts"] is None
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        (["--uncertainty", "bootstrap"], "--uncertainty"),
+        (["--uq-calibration", "missing.json"], "no such interval calibration"),
+    ],
+)
+def test_identify_refuses_a_bad_uncertainty_option_before_the_work(tmp_path, capsys, args, reason):
+    out = tmp_path / "r.json"
+    code, _, err = run_cli(
+        ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--output", str(out), *args, *FAST], capsys
+    )
+    assert code == 2 and reason in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
 
 
 def test_identify_from_a_reference_trace(tmp_path, capsys):

@@ -43,6 +43,7 @@ err = Console(stderr=True, highlight=False)
 # literals, so that the CLI starts without numpy (tests/test_cli.py checks them against the code)
 HEALTHY_TEXT = "0,0,0,0,0,0,0,0.5"  # emaphm.faults.HEALTHY
 COMMAND_NAMES = ("chirp", "chirp-hold", "steps", "step", "ramp", "sine")  # emaphm.commands.COMMANDS
+UQ_METHOD_NAMES = ("none", "laplace", "mcmc")  # emaphm.identification.uncertainty.UQ_METHODS
 
 
 def _status(message: str) -> Any:
@@ -131,6 +132,17 @@ def identify(
     ] = None,
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
     monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
+    uncertainty: Annotated[
+        str,
+        typer.Option(
+            help="90 % interval per fault: laplace (fast, default), mcmc (emcee, minutes; "
+            "pip install 'emaphm[uq]') or none."
+        ),
+    ] = "laplace",
+    uq_calibration: Annotated[
+        Path | None,
+        typer.Option(help="Interval calibration from 'emaphm calibrate-uq' (default: the packaged one)."),
+    ] = None,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current."""
     import json
@@ -143,18 +155,27 @@ def identify(
 
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of --true-faults or --reference")
+    if uncertainty not in UQ_METHOD_NAMES:
+        raise InputError(f"unknown --uncertainty {uncertainty!r}; use one of {', '.join(UQ_METHOD_NAMES)}")
     check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     check_seed(seed)
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
     if reference is not None:
         check_trace_path(reference, for_writing=False)
     if output is not None:
-        check_output_path(output, suffixes=(".json",), inputs=(reference, calibration))
+        check_output_path(output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration))
+    if uncertainty != "none":
+        from .identification.uncertainty import load_factors
+
+        load_factors(uq_calibration)  # a bad file: refused before the work
     with _progress() as update:
         result = run_identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
             generations=generations, local_polish=polish, calibration=calibration, monitor=monitor,
-            on_generation=lambda gen, total, best: update(f"{optimizer.upper()} generations", gen, total),
+            uncertainty=uncertainty, uq_calibration=uq_calibration,
+            on_generation=lambda gen, total, best: update(
+                "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
+            ),
         )  # fmt: skip
     data = result.to_json()
     for warning in data["warnings"]:
@@ -173,13 +194,38 @@ def identify(
 def _print_identification(data: dict[str, Any]) -> None:
     from rich.table import Table
 
-    table = Table(title=f"identified faults ({data['optimizer']}, seed {data['seed']})")
-    table.add_column("")
-    for i in range(len(data["estimate"])):
-        table.add_column(f"k{i + 1}", justify="right")
+    title = f"identified faults ({data['optimizer']}, seed {data['seed']}"
+    title += f", 90 % intervals by {data['uq_method']})" if data["ci90_low"] is not None else ")"
+    table = Table(title=title)
+    columns = ["fault", "identified"]
+    if data["ci90_low"] is not None:
+        columns += ["± half-width", "90 % interval", "flags"]
     if data["truth"] is not None:
-        table.add_row("true", *(f"{v:.4g}" for v in data["truth"]))
-    table.add_row("identified", *(f"{v:.4g}" for v in data["estimate"]))
+        columns.append("true")
+    columns.append("verdict")
+    for name in columns:
+        table.add_column(name, justify="left" if name in ("fault", "flags", "verdict") else "right")
+    verdicts = data.get("fault_verdicts") or {}
+    for i, name in enumerate(data["fault_names"]):
+        row = [f"k{i + 1} {name}", f"{data['estimate'][i]:.4f}"]
+        if data["ci90_low"] is not None:
+            lo, hi = data["ci90_low"][i], data["ci90_high"][i]
+            whole = name == "eccentricity_phase" and lo == 0.0 and hi == 1.0
+            half = 0.5 if whole else ((hi - lo) % 1.0 if name == "eccentricity_phase" else hi - lo) / 2
+            row += [
+                f"{half:.4f}",
+                "whole circle" if whole else f"[{lo:.4f}, {hi:.4f}]",
+                " ".join(data["uq_flags"][i]),
+            ]
+        if data["truth"] is not None:
+            row.append(f"{data['truth'][i]:.4f}")
+        if data["verdict"] != "fits":
+            row.append("-")
+        elif verdicts:
+            row.append(verdicts.get(name, "(direction)"))
+        else:
+            row.append("present" if name in data["detected"] else "-")
+        table.add_row(*row)
     out = _stdout_console()
     out.print(table)
     if data["percent_error"] is not None:
@@ -188,6 +234,11 @@ def _print_identification(data: dict[str, Any]) -> None:
         out.print("verdict: does not fit (see the warning): no faults reported")
     else:
         out.print(f"detected: {', '.join(data['detected']) or 'none (healthy)'}")
+        unsure = [n for n, v in verdicts.items() if v == "cannot tell"]
+        if unsure:
+            out.print(
+                f"cannot tell: {', '.join(unsure)} (the estimate departs from healthy, its interval reaches back)"
+            )
     out.print(
         f"fitness {data['fitness']:.4g}, {data['evaluations']} evaluations, {data['wall_time_s']:.1f} s"
     )
@@ -224,6 +275,43 @@ def calibrate(
             f"{title}: NRMSE {100 * min(values):.1f} to {100 * max(values):.1f} % over {len(values)} scenarios"
         )
     err.print(f"wrote {output} (seed {seed}, {cal.record['settings']['wall_time_s']:.0f} s)")
+
+
+@app.command("calibrate-uq")
+def calibrate_uq(
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Interval calibration file to write (JSON).")
+    ] = Path("uq-calibration.json"),
+    cases: Annotated[int, typer.Option(help="Random HF actuators to identify (about 5 s each).")] = 80,
+    seed: Annotated[int, typer.Option(help="Seed of the cases, their noise and the optimiser.")] = 4101,
+    calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
+    monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
+    workers: Annotated[int, typer.Option(help="Threads for the population kernel (0: all cores).")] = 0,
+) -> None:
+    """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
+    from .identification.calibrate_uq import calibrate_uq as run_calibrate_uq
+    from .io import check_output_path
+    from .models import MonitorEma, check_seed
+
+    check_seed(seed)
+    if cases < 20:
+        raise InputError(f"--cases must be >= 20 (coverage needs a sample), got {cases}")
+    check_output_path(output, suffixes=(".json",), inputs=(calibration,))
+    MonitorEma(calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
+    with numba_threads(workers, name="--workers"), _progress() as update:
+
+        def report(stage: str, done: int, total: int) -> None:
+            update(stage, done, total)
+            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
+                err.print(f"{done}/{total} {stage}")
+
+        factors = run_calibrate_uq(
+            cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report
+        )
+    factors.save(output)
+    for name, fit in factors.record["training"].items():
+        err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
+    err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")
 
 
 def _stdout_console() -> Console:

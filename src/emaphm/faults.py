@@ -176,10 +176,22 @@ RANDOM_CASE_RANGES: tuple[tuple[float, float], ...] = (
 """DESIGN §7 ranges of the random benchmark cases, (low, high) per fault k1..k8."""
 
 
-def random_faults(n: int, seed: int) -> NDArray[np.float64]:
-    """n random fault vectors, uniform in `RANDOM_CASE_RANGES`, from `seed` (shape (n, 8))."""
+def random_faults(n: int, seed: int, *, absent: float = 0.0) -> NDArray[np.float64]:
+    """n random fault vectors, uniform in `RANDOM_CASE_RANGES`, from `seed` (shape (n, 8)).
+
+    With `absent` > 0 each fault but k7 is healthy (`HEALTHY`) with that probability, drawn
+    from a stream of its own (the values are those of ``absent=0``): actuators where some faults
+    are truly absent, on which spurious detections can be counted.
+    """
+    if not 0.0 <= absent <= 1.0:
+        raise InputError(f"absent must be a probability in [0, 1], got {absent}")
     low, high = np.array(RANDOM_CASE_RANGES).T
-    return low + (high - low) * np.random.default_rng(seed).uniform(size=(n, len(FAULT_NAMES)))
+    K = low + (high - low) * np.random.default_rng(seed).uniform(size=(n, len(FAULT_NAMES)))
+    if absent > 0.0:
+        healthy = np.random.default_rng([seed, 1]).uniform(size=K.shape) < absent
+        healthy[:, 6] = False  # k7 is the direction of k6, not a fault of its own
+        K = np.where(healthy, HEALTHY, K)
+    return K
 
 
 def describe(k: Sequence[float] | NDArray[np.float64]) -> str:

@@ -108,9 +108,19 @@ def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
 
 
 def plot_vectors(
-    truth: np.ndarray, estimates: Mapping[str, np.ndarray], names: tuple[str, ...], path: Path
+    truth: np.ndarray,
+    estimates: Mapping[str, np.ndarray],
+    names: tuple[str, ...],
+    path: Path,
+    intervals: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    phase_undefined: bool = False,
 ) -> Path:
-    """Identified vs true fault vector, one group of bars per fault."""
+    """Identified vs true fault vector, one group of bars per fault.
+
+    `intervals` (label → (ci90_low, ci90_high)) draws each estimate's 90 % interval as an error
+    bar (k7 only when its arc does not wrap through 0). With `phase_undefined` the k7 group is
+    greyed out: the eccentricity is too small for its direction to mean anything.
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 4), layout="constrained")
     n = len(estimates) + 1
@@ -118,9 +128,21 @@ def plot_vectors(
     x = np.arange(len(truth))
     ax.bar(x - 0.4 + width / 2, truth, width, color="k", label="true")
     for j, (label, k) in enumerate(estimates.items(), start=1):
-        ax.bar(x - 0.4 + width / 2 + j * width, k, width, label=label)
+        pos = x - 0.4 + width / 2 + j * width
+        bars = ax.bar(pos, k, width, label=label)
+        if phase_undefined:
+            bars[6].set_color("0.8")
+        if intervals is not None and label in intervals:
+            lo, hi = (np.asarray(v, dtype=float) for v in intervals[label])
+            ok = np.ones(len(k), dtype=bool)
+            ok[6] = (not phase_undefined) and lo[6] <= k[6] <= hi[6]
+            err = np.vstack([np.clip(k - lo, 0, None), np.clip(hi - k, 0, None)])
+            ax.errorbar(pos[ok], np.asarray(k)[ok], yerr=err[:, ok], fmt="none", ecolor="0.2", elinewidth=0.8,
+                        capsize=1.5)  # fmt: skip
+    if phase_undefined:
+        ax.annotate("direction\nundefined", (x[6], 0.02), ha="center", fontsize=7, color="0.4")
     ax.set_xticks(x, [f"k{i + 1}\n{nm}" for i, nm in enumerate(names)], fontsize=7)
-    ax.set_ylabel("fault value [-]")
+    ax.set_ylabel("fault value [-]" + (" (bars: 90 % intervals)" if intervals else ""))
     ax.legend(fontsize=7, ncols=3)
     ax.grid(alpha=0.3, axis="y")
     fig.savefig(path, dpi=110)

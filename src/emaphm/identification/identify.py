@@ -41,6 +41,7 @@ from .optimizers import (
     run_optimizer,
 )
 from .signals import Comparison, nrmse
+from .uncertainty import UQ_METHODS, Factors, Uncertainty, laplace, load_factors, verdicts
 
 __all__ = [
     "FIT_NRMSE_LIMIT",
@@ -93,6 +94,10 @@ class IdentificationResult:
     version: str = __version__
     warnings: list[str] = field(default_factory=list)
     fit_nrmse: float | None = None
+    # the 90 % intervals and flags of each fault (`uncertainty`); None with uncertainty="none"
+    uncertainty: Uncertainty | None = None
+    # per detectable fault: "present", "absent" or "cannot tell" (`uncertainty.verdicts`)
+    fault_verdicts: dict[str, str] | None = None
 
     @property
     def fits(self) -> bool:
@@ -134,6 +139,20 @@ class IdentificationResult:
             "settings": self.settings,
             # a generation whose best row diverged has no finite best: null, so the JSON stays valid
             "history": [float(v) if np.isfinite(v) else None for v in self.history],
+            "fault_verdicts": self.fault_verdicts,
+            **(
+                self.uncertainty.to_json()
+                if self.uncertainty is not None
+                else {
+                    "uq_method": "none",
+                    "std": None,
+                    "ci90_low": None,
+                    "ci90_high": None,
+                    "corr": None,
+                    "uq_flags": None,
+                    "uq": None,
+                }
+            ),
         }
 
 
@@ -366,6 +385,8 @@ def identify(
     thresholds: dict[str, float] | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
     monitor: str | None = None,
+    uncertainty: str = "laplace",
+    uq_calibration: Factors | str | os.PathLike[str] | None = None,
 ) -> IdentificationResult:
     """Identify the faults from `reference` (a trace file or `SimResult`), or from the HF twin run
     with `true_faults` and noise on (DESIGN §8). Exactly one of the two must be given.
@@ -376,9 +397,28 @@ def identify(
     packaged one by default); one made for other actuator parameters raises `InputError`.
     `monitor` picks the monitor model: "default", or "paper" (the paper's single-phase model,
     eqs. 1–2 alone, to reproduce the paper); None: the calibration's (`MonitorEma`).
+
+    `uncertainty` gives each fault a 90 % interval and flags (`uncertainty`, docs/uncertainty.md):
+    "laplace" (default, ≈ 33 more evaluations), "mcmc" (emcee, the ``emaphm[uq]`` extra; minutes)
+    or "none". With intervals a fault is detected only when its interval excludes healthy by more
+    than its threshold (`uncertainty.verdicts`). `uq_calibration` is the interval calibration
+    (`Factors` or a file from ``emaphm calibrate-uq``; the packaged one by default).
     """
     seed = check_seed(seed)
     check_optimizer(optimizer)  # before the twin runs
+    if uncertainty not in UQ_METHODS:
+        raise InputError(f"unknown uncertainty method {uncertainty!r}; use one of {', '.join(UQ_METHODS)}")
+    if uncertainty == "mcmc":
+        from .mcmc import check_emcee
+
+        check_emcee()
+    factors = (
+        None
+        if uncertainty == "none"
+        else uq_calibration
+        if isinstance(uq_calibration, Factors)
+        else load_factors(uq_calibration)
+    )
     monitor_model = MonitorEma(calibration=calibration, monitor=monitor)  # one that does not fit: now
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
@@ -424,12 +464,43 @@ def identify(
             f"{monitor_model.monitor!r} one: faults near them may be reported wrongly"
         )
     fits = explains(ident.fit_nrmse_)
+    interval: Uncertainty | None = None
+    if factors is not None and fits:
+        if factors.record and not factors.matches(monitor_model.calibration):
+            warnings.append(
+                "the interval calibration was fitted with another LF calibration or monitor: the "
+                "intervals show the measurement noise only, not the model's bias (run 'emaphm calibrate-uq')"
+            )
+            factors = Factors.identity()
+        uq_start = time.perf_counter()
+        with numba_threads(workers):
+            interval = laplace(ident.objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
+                               factors=factors)  # fmt: skip
+            if uncertainty == "mcmc":
+                from .mcmc import sample
+
+                interval = sample(ident, interval, factors=factors, seed=opt_seed, on_step=on_generation)
+                if not interval.details["converged"]:
+                    warnings.append(
+                        f"the MCMC chain did not converge in {interval.details['steps']} steps (autocorrelation "
+                        f"times up to {max(interval.details['autocorr_time']):.0f} steps): its intervals are indicative"
+                    )
+        interval.details["wall_time_s"] = round(time.perf_counter() - uq_start, 4)
     if not fits:
         warnings.append(
             f"the monitor cannot explain this recording (NRMSE {100 * ident.fit_nrmse_:.3g} % of the "
             f"filtered current, at most {100 * FIT_NRMSE_LIMIT:g} % for a diagnosis): check the units, "
             "signs and command of the trace; no faults are reported"
         )
+    limits = thresholds if thresholds is not None else load_thresholds()["thresholds"]
+    judged = None
+    if not fits:
+        detected: list[str] = []
+    elif interval is None:
+        detected = detect(ident.faults_, limits)
+    else:
+        judged = verdicts(ident.faults_, interval.ci90_low, interval.ci90_high, limits)
+        detected = [name for name, v in judged.items() if v == "present"]
     settings = {
         "reference": source,
         "noise_seed": noise_seed if true_faults is not None else None,
@@ -457,11 +528,23 @@ def identify(
             "params_hash": monitor_model.calibration.params_hash,
             "monitor": monitor_model.monitor,
         },
+        "uncertainty": uncertainty,
+        "uq_calibration": None
+        if factors is None
+        else {
+            "source": "packaged"
+            if uq_calibration is None
+            else str(uq_calibration)
+            if not isinstance(uq_calibration, Factors)
+            else "Factors object",
+            "created": factors.record.get("created"),
+            "calibrated": bool(factors.record),
+        },
         "versions": versions(),
     }
     return IdentificationResult(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=run.evaluations,
         wall_time_s=round(time.perf_counter() - start, 3), seed=seed, optimizer=optimizer, truth=truth,
-        detected=detect(ident.faults_, thresholds) if fits else [], history=run.history,
-        settings=settings, warnings=warnings, fit_nrmse=ident.fit_nrmse_,
+        detected=detected, history=run.history, settings=settings, warnings=warnings,
+        fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged,
     )  # fmt: skip

@@ -1,0 +1,107 @@
+"""Calibration of the 90 % intervals for the monitor's discrepancy (issue 9, item 3; ``emaphm calibrate-uq``).
+
+The Laplace intervals (`uncertainty.laplace`) see the measurement noise only; the monitor's
+discrepancy from the actuator biases every estimate by more than that. This module identifies
+random actuators of the HF twin (noise on) whose truth is known, keeps each estimate with its
+noise-only σ, and fits a scale and a floor per fault (`uncertainty.fit_factors`) so that 90 % of
+the intervals hold with the narrowest median interval. The cases are drawn from a seed of their
+own (`UQ_CASE_SEED`), different from every benchmark's; a third of the faults are truly absent
+(`faults.random_faults(absent=...)`), so that intervals at the bound are calibrated too.
+
+The result is tied to the LF calibration it was fitted with (its monitor, date and actuator):
+identification with another calibration falls back to noise-only intervals and says so. Re-run
+``emaphm calibrate-uq`` whenever the monitor model or its calibration changes.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .._versions import versions
+from ..calibration import Calibration
+from ..errors import InputError
+from ..faults import random_faults
+from ..models import MonitorEma, check_seed
+from .uncertainty import FIT_COVERAGE, Factors, fit_factors
+
+__all__ = ["UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"]
+
+UQ_CASE_SEED = 4101  # no benchmark draws from it (bench_multifault 2611, uq_coverage 4201)
+UQ_CASES = 80
+UQ_ABSENT = 1.0 / 3.0  # the probability that each fault of a case is absent
+
+Progress = Callable[[str, int, int], None]
+
+
+def collect_cases(
+    cases: int,
+    seed: int,
+    *,
+    calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
+    absent: float = UQ_ABSENT,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
+    """Identify `cases` random actuators (HF twin, noise on; identification seed 1000·seed + i)
+    with noise-only Laplace intervals: {"truths", "estimates", "raw_std"} arrays (cases x 8)."""
+    from .identify import identify
+
+    K = random_faults(cases, seed, absent=absent)
+    estimates, raw, walls = np.empty_like(K), np.empty_like(K), []
+    for i, k in enumerate(K):
+        r = identify(
+            true_faults=k, seed=1000 * seed + i, calibration=calibration, monitor=monitor,
+            uncertainty="laplace", uq_calibration=Factors.identity(),
+        )  # fmt: skip
+        if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
+            raise InputError(
+                f"case {i} ({k.tolist()}) did not fit (NRMSE {r.fit_nrmse}); cannot calibrate on it"
+            )
+        estimates[i], raw[i] = r.estimate, r.uncertainty.raw_std
+        walls.append(r.wall_time_s)
+        if progress is not None:
+            progress("identifications", i + 1, cases)
+    return {"truths": K, "estimates": estimates, "raw_std": raw, "wall_time_s": walls}
+
+
+def calibrate_uq(
+    *,
+    cases: int = UQ_CASES,
+    seed: int = UQ_CASE_SEED,
+    calibration: Calibration | str | os.PathLike[str] | None = None,
+    monitor: str | None = None,
+    progress: Progress | None = None,
+) -> Factors:
+    """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores)."""
+    seed = check_seed(seed)
+    if not isinstance(cases, int) or cases < 20:
+        raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
+    lf = MonitorEma(calibration=calibration, monitor=monitor).calibration
+    start = time.perf_counter()
+    data = collect_cases(cases, seed, calibration=calibration, monitor=monitor, progress=progress)
+    fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"])
+    record = {
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "method": "laplace",
+        "lf_calibration": {
+            "monitor": lf.monitor,
+            "created": lf.record.get("created"),
+            "params_hash": lf.params_hash,
+        },
+        "cases": cases,
+        "seed": seed,
+        "absent": UQ_ABSENT,
+        "form": "sigma = sqrt((scale * sigma_raw)^2 + floor^2); the narrowest median interval covering coverage_target of these cases",
+        "coverage_target": FIT_COVERAGE,
+        "training": report,
+        "wall_time_s": round(time.perf_counter() - start, 1),
+        "versions": versions(),
+        "data": {k: np.asarray(v).round(6).tolist() for k, v in data.items() if k != "wall_time_s"},
+    }
+    return Factors(fitted.scale, fitted.floor, record)
