@@ -312,3 +312,10 @@ def test_calibrate_and_identify_refuse_an_unknown_monitor_before_any_work(tmp_pa
     assert not out.exists()
     code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--monitor", "exact"], capsys)
     assert code == 2 and "unknown monitor 'exact'" in err
+
+
+def test_calibrate_uq_refuses_too_few_cases_before_the_work(tmp_path, capsys):
+    out = tmp_path / "uq.json"
+    code, _, err = run_cli(["calibrate-uq", "--cases", "5", "--output", str(out)], capsys)
+    assert code == 2 and "--cases" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

@@ -282,7 +282,7 @@ def calibrate_uq(
     output: Annotated[
         Path, typer.Option("--output", "-o", help="Interval calibration file to write (JSON).")
     ] = Path("uq-calibration.json"),
-    cases: Annotated[int, typer.Option(help="Random HF actuators to identify (about 5 s each).")] = 80,
+    cases: Annotated[int, typer.Option(help="Random HF actuators to identify (about 5 s each).")] = 160,
     seed: Annotated[int, typer.Option(help="Seed of the cases, their noise and the optimiser.")] = 4101,
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
     monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,

@@ -142,7 +142,7 @@ def plot_vectors(
     if phase_undefined:
         ax.annotate("direction\nundefined", (x[6], 0.02), ha="center", fontsize=7, color="0.4")
     ax.set_xticks(x, [f"k{i + 1}\n{nm}" for i, nm in enumerate(names)], fontsize=7)
-    ax.set_ylabel("fault value [-]" + (" (bars: 90 % intervals)" if intervals else ""))
+    ax.set_ylabel("fault value [-]" + ("; whiskers: 90 % intervals" if intervals else ""))
     ax.legend(fontsize=7, ncols=3)
     ax.grid(alpha=0.3, axis="y")
     fig.savefig(path, dpi=110)

@@ -33,7 +33,7 @@ from .uncertainty import FIT_COVERAGE, Factors, fit_factors
 __all__ = ["UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"]
 
 UQ_CASE_SEED = 4101  # no benchmark draws from it (bench_multifault 2611, uq_coverage 4201)
-UQ_CASES = 80
+UQ_CASES = 160
 UQ_ABSENT = 1.0 / 3.0  # the probability that each fault of a case is absent
 
 Progress = Callable[[str, int, int], None]
@@ -46,15 +46,18 @@ def collect_cases(
     calibration: Calibration | str | os.PathLike[str] | None = None,
     monitor: str | None = None,
     absent: float = UQ_ABSENT,
+    first: int = 0,
     progress: Progress | None = None,
 ) -> dict[str, Any]:
-    """Identify `cases` random actuators (HF twin, noise on; identification seed 1000·seed + i)
-    with noise-only Laplace intervals: {"truths", "estimates", "raw_std"} arrays (cases x 8)."""
+    """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
+    identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
+    "raw_std"} arrays (one row per case). The draws do not depend on `cases`, so a longer set
+    extends a shorter one, and `first` resumes one."""
     from .identify import identify
 
-    K = random_faults(cases, seed, absent=absent)
+    K = random_faults(cases, seed, absent=absent)[first:]
     estimates, raw, walls = np.empty_like(K), np.empty_like(K), []
-    for i, k in enumerate(K):
+    for i, k in enumerate(K, start=first):
         r = identify(
             true_faults=k, seed=1000 * seed + i, calibration=calibration, monitor=monitor,
             uncertainty="laplace", uq_calibration=Factors.identity(),
@@ -63,7 +66,7 @@ def collect_cases(
             raise InputError(
                 f"case {i} ({k.tolist()}) did not fit (NRMSE {r.fit_nrmse}); cannot calibrate on it"
             )
-        estimates[i], raw[i] = r.estimate, r.uncertainty.raw_std
+        estimates[i - first], raw[i - first] = r.estimate, r.uncertainty.raw_std
         walls.append(r.wall_time_s)
         if progress is not None:
             progress("identifications", i + 1, cases)
