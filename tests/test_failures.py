@@ -133,10 +133,13 @@ def test_ctrl_c_during_identify_exits_130_with_one_line(tmp_path):
     out = tmp_path / "r.json"
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "emaphm", "identify", "--true-faults", "0.2,0,0,0,0,0,0,0.5", "--output", str(out)],
+        [sys.executable, "-m", "emaphm", "identify", "--true-faults", "0.2,0,0,0,0,0,0,0.5", "--output", str(out),
+         "--pop-size", "400", "--generations", "400"],
         stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env,
     )  # fmt: skip
-    time.sleep(4.0)  # inside the twin or the search (a run takes > 5 s)
+    # inside the twin or the search: a 400 x 400 search takes minutes (the default one can end in
+    # under 4 s on a fast moment of a shared machine, and then the signal came too late)
+    time.sleep(4.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130

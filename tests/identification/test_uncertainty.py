@@ -208,3 +208,40 @@ def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
     width_laplace = local.ci90_high - local.ci90_low
     # a linear-Gaussian posterior: the chain's intervals are the Laplace ones, to sampling error
     np.testing.assert_allclose(width_mcmc[[0, 1, 2, 3, 4, 7]], width_laplace[[0, 1, 2, 3, 4, 7]], rtol=0.35)
+
+
+TINY = {"pop_size": 16, "generations": 3, "local_polish": False}
+
+
+def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_says_so():
+    from emaphm.identification.identify import identify
+
+    res = identify([0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, monitor="paper", **TINY)
+    if not res.fits:  # a 16 x 3 search may not explain the measurement: then no intervals at all
+        assert res.uncertainty is None
+        return
+    assert any("interval calibration" in w for w in res.warnings)
+    assert res.settings["uq_calibration"]["calibrated"] is False
+    np.testing.assert_allclose(
+        res.uncertainty.std[[0, 1, 2, 3, 4, 7]], res.uncertainty.raw_std[[0, 1, 2, 3, 4, 7]]
+    )
+
+
+def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):
+    from emaphm.identification import mcmc
+    from emaphm.identification.identify import identify
+
+    monkeypatch.setattr(mcmc, "MAX_STEPS", 60)
+    monkeypatch.setattr(mcmc, "CHUNK", 30)
+    steps = []
+    res = identify(
+        [0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, uncertainty="mcmc", on_generation=lambda g, t, b: steps.append(g),
+        pop_size=16, generations=5,
+    )  # fmt: skip
+    assert res.fits
+    data = res.to_json()
+    assert data["uq_method"] == "mcmc" and data["uq"]["steps"] == 60 and data["uq"]["converged"] is False
+    assert any("did not converge" in w for w in res.warnings)
+    assert [-30, -60] == [g for g in steps if g < 0]  # the chain's progress, as negative steps
+    for j in (0, 1, 2, 3, 4, 5, 7):
+        assert data["ci90_low"][j] <= data["ci90_high"][j]

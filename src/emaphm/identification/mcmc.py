@@ -60,8 +60,8 @@ def sample(
     factors: Factors,
     seed: int,
     walkers: int = WALKERS,
-    chunk: int = CHUNK,
-    max_steps: int = MAX_STEPS,
+    chunk: int | None = None,
+    max_steps: int | None = None,
     on_step: Callable[[int, int, float], None] | None = None,
 ) -> Uncertainty:
     """Posterior intervals about a fitted `FaultIdentifier` (module docstring); `local` is its
@@ -70,6 +70,8 @@ def sample(
     import emcee
 
     check_emcee()
+    chunk = CHUNK if chunk is None else chunk  # the module's values at call time
+    max_steps = MAX_STEPS if max_steps is None else max_steps
     u0 = to_cartesian(ident.faults_)[0]
     tau_r, s2 = float(local.details["residual_tau"]), float(local.details["s2"])
     temper = 2.0 * tau_r * s2
