@@ -120,6 +120,10 @@ def test_the_phase_interval_wraps_through_zero_and_is_the_circle_when_undefined(
     _, lo, hi, flags = intervals(k, std)
     assert lo[6] > hi[6]  # an arc through 0
     assert covers(lo, hi, np.r_[k[:6], 0.005, 0.5])[6] and not covers(lo, hi, np.r_[k[:6], 0.5, 0.5])[6]
+    from emaphm.identification.uncertainty import Uncertainty
+
+    arc = Uncertainty("laplace", std, lo, hi, np.eye(8), flags, std, 0)
+    assert arc.half_width()[6] == pytest.approx(1.6449 * 0.01, rel=1e-3)  # the arc through 0, not 1 - it
     k[5] = 0.003  # ζ within 2 σ of 0: the direction means nothing
     std_u, lo, hi, flags = intervals(k, std)
     assert (lo[6], hi[6]) == (0.0, 1.0) and "phase_undefined" in flags[6] and np.isnan(std_u[6])

@@ -220,7 +220,8 @@ class Uncertainty:
     def half_width(self) -> NDArray[np.float64]:
         """Half the length of each 90 % interval (k7: of its arc)."""
         width = self.ci90_high - self.ci90_low
-        width[PHASE] = np.mod(width[PHASE], 1.0) if self.ci90_high[PHASE] != 1.0 else 1.0
+        whole = self.ci90_low[PHASE] == 0.0 and self.ci90_high[PHASE] == 1.0
+        width[PHASE] = 1.0 if whole else np.mod(width[PHASE], 1.0)
         return width / 2.0  # type: ignore[no-any-return]
 
     def to_json(self) -> dict[str, Any]:
