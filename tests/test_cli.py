@@ -234,6 +234,7 @@ def test_identify_without_uncertainty_gives_null_intervals(capsys):
     [
         (["--uncertainty", "bootstrap"], "--uncertainty"),
         (["--uq-calibration", "missing.json"], "no such interval calibration"),
+        (["--uq-calibration", "missing.json", "--uncertainty", "none"], "--uq-calibration needs"),
     ],
 )
 def test_identify_refuses_a_bad_uncertainty_option_before_the_work(tmp_path, capsys, args, reason):

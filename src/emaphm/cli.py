@@ -164,6 +164,8 @@ def identify(
         check_trace_path(reference, for_writing=False)
     if output is not None:
         check_output_path(output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration))
+    if uncertainty == "none" and uq_calibration is not None:
+        raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
     if uncertainty != "none":
         from .identification.uncertainty import load_factors
 

@@ -155,7 +155,11 @@ def run_demo(
         for j, r in enumerate(results, start=1)
         if r.uncertainty is not None
     }
-    undefined = best.uncertainty is not None and "phase_undefined" in best.uncertainty.flags[6]
+    undefined = {
+        f"seed {j}"
+        for j, r in enumerate(results, start=1)
+        if r.uncertainty is not None and "phase_undefined" in r.uncertainty.flags[6]
+    }
     figures = [
         plot_response({"healthy": healthy, "Table 1 faults": measured}, output_dir / "hf_table1.png",
                       "High-fidelity EMA twin, FDI chirp (noise on)"),

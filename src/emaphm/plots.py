@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -113,13 +113,13 @@ def plot_vectors(
     names: tuple[str, ...],
     path: Path,
     intervals: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-    phase_undefined: bool = False,
+    phase_undefined: Collection[str] = (),
 ) -> Path:
     """Identified vs true fault vector, one group of bars per fault.
 
     `intervals` (label → (ci90_low, ci90_high)) draws each estimate's 90 % interval as an error
-    bar (k7 only when its arc does not wrap through 0). With `phase_undefined` the k7 group is
-    greyed out: the eccentricity is too small for its direction to mean anything.
+    bar (k7 only when its arc does not wrap through 0). The k7 bar of each label in
+    `phase_undefined` is greyed out: its eccentricity is too small for its direction to mean anything.
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 4), layout="constrained")
@@ -130,12 +130,13 @@ def plot_vectors(
     for j, (label, k) in enumerate(estimates.items(), start=1):
         pos = x - 0.4 + width / 2 + j * width
         bars = ax.bar(pos, k, width, label=label)
-        if phase_undefined:
+        undefined = label in phase_undefined
+        if undefined:
             bars[6].set_color("0.8")
         if intervals is not None and label in intervals:
             lo, hi = (np.asarray(v, dtype=float) for v in intervals[label])
             ok = np.ones(len(k), dtype=bool)
-            ok[6] = (not phase_undefined) and lo[6] <= k[6] <= hi[6]
+            ok[6] = (not undefined) and lo[6] <= k[6] <= hi[6]
             err = np.vstack([np.clip(k - lo, 0, None), np.clip(hi - k, 0, None)])
             ax.errorbar(pos[ok], np.asarray(k)[ok], yerr=err[:, ok], fmt="none", ecolor="0.2", elinewidth=0.8,
                         capsize=1.5)  # fmt: skip

@@ -249,3 +249,35 @@ def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(mo
     assert [-30, -60] == [g for g in steps if g < 0]  # the chain's progress, as negative steps
     for j in (0, 1, 2, 3, 4, 5, 7):
         assert data["ci90_low"][j] <= data["ci90_high"][j]
+
+
+def test_a_parameter_the_measurement_cannot_see_gets_the_whole_box_and_is_never_present():
+    n = 4000
+    monitor = LinearMonitor(n)
+    monitor.G[1] = 0.0  # backlash does not change the current at all
+    truth = np.array([0.4, 0.5, 0.3, 0.6, 0.45, 0.2, 0.1, 0.55])
+    t = np.arange(n) / F_S
+    measured = to_cartesian(truth)[0] @ monitor.G + np.random.default_rng(2).normal(0, 0.05, n)
+    res = laplace(Fitness(Comparison.from_signal(t, measured, F_S)), monitor, truth)  # type: ignore[arg-type]
+    assert "non_identifiable" in res.flags[1] and (res.ci90_low[1], res.ci90_high[1]) == (0.0, 1.0)
+    assert res.details["non_identifiable"] == [["backlash"]]
+    assert verdicts(truth, res.ci90_low, res.ci90_high, {"backlash": 0.01})["backlash"] == "cannot tell"
+    assert res.to_json()["std"][1] is None  # inf is not JSON
+    assert all(np.isfinite(res.std[[0, 2, 3, 4, 7]]))
+
+
+def test_fit_factors_refuses_cases_no_factor_can_cover():
+    truth = np.full((50, 8), 0.5)
+    estimates = truth.copy()
+    estimates[:, 0] = 0.95  # errors of 0.45: beyond any scale and floor of the grid
+    with pytest.raises(InputError, match="friction"):
+        fit_factors(estimates, np.full((50, 8), 1e-4), truth)
+
+
+def test_non_finite_details_become_null_in_json():
+    from emaphm.identification.uncertainty import Uncertainty
+
+    s = np.full(8, 0.01)
+    u = Uncertainty("mcmc", s, s, s, np.eye(8), [[] for _ in range(8)], s, 0, {"autocorr_time": [np.nan, 3.0]})
+    assert u.to_json()["uq"]["autocorr_time"] == [None, 3.0]
+    json.dumps(u.to_json(), allow_nan=False)

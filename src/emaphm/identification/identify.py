@@ -474,18 +474,26 @@ def identify(
             factors = Factors.identity()
         uq_start = time.perf_counter()
         with numba_threads(workers):
-            interval = laplace(ident.objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
-                               factors=factors)  # fmt: skip
-            if uncertainty == "mcmc":
+            try:
+                interval = laplace(ident.objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
+                                   factors=factors)  # fmt: skip
+            except InputError as exc:  # the estimate stands; only its intervals cannot be given
+                warnings.append(f"no intervals: {exc}; faults are detected by the point rule")
+            if interval is not None and uncertainty == "mcmc":
                 from .mcmc import sample
 
-                interval = sample(ident, interval, factors=factors, seed=opt_seed, on_step=on_generation)
-                if not interval.details["converged"]:
-                    warnings.append(
-                        f"the MCMC chain did not converge in {interval.details['steps']} steps (autocorrelation "
-                        f"times up to {max(interval.details['autocorr_time']):.0f} steps): its intervals are indicative"
-                    )
-        interval.details["wall_time_s"] = round(time.perf_counter() - uq_start, 4)
+                try:
+                    interval = sample(ident, interval, factors=factors, seed=opt_seed, on_step=on_generation)
+                except InputError as exc:
+                    warnings.append(f"MCMC failed ({exc}): the Laplace intervals are reported")
+                else:
+                    if not interval.details["converged"]:
+                        warnings.append(
+                            f"the MCMC chain did not converge in {interval.details['steps']} steps (autocorrelation "
+                            f"times up to {np.nanmax(interval.details['autocorr_time']):.0f} steps): its intervals are indicative"
+                        )
+        if interval is not None:
+            interval.details["wall_time_s"] = round(time.perf_counter() - uq_start, 4)
     if not fits:
         warnings.append(
             f"the monitor cannot explain this recording (NRMSE {100 * ident.fit_nrmse_:.3g} % of the "

@@ -75,6 +75,8 @@ def sample(
     u0 = to_cartesian(ident.faults_)[0]
     tau_r, s2 = float(local.details["residual_tau"]), float(local.details["s2"])
     temper = 2.0 * tau_r * s2
+    if not (np.isfinite(temper) and temper > 0):
+        raise InputError("the residual at the estimate is zero: no likelihood to sample")
     monitor, duration, objective = ident.monitor_, ident.duration_, ident.objective_
     evaluations = [0]
 
@@ -184,6 +186,7 @@ def summarise(
         std[j] = float(np.sqrt((c * std[j]) ** 2 + b**2))
     q5, q95 = np.quantile(d, [0.05, 0.95])
     half = np.sqrt((factors.scale[PHASE] * max(-q5, q95)) ** 2 + (Z90 * factors.floor[PHASE]) ** 2)
+    std[PHASE] = float(np.sqrt((factors.scale[PHASE] * std[PHASE]) ** 2 + factors.floor[PHASE] ** 2))
     if undefined or half >= 0.5:
         lo[PHASE], hi[PHASE] = 0.0, 1.0
         if undefined:
@@ -191,7 +194,6 @@ def summarise(
             std[PHASE] = np.nan
     else:
         lo[PHASE], hi[PHASE] = np.mod(mean_dir - half, 1.0), np.mod(mean_dir + half, 1.0)
-        std[PHASE] = float(np.sqrt((factors.scale[PHASE] * std[PHASE]) ** 2 + factors.floor[PHASE] ** 2))
     u = to_cartesian(K)
     corr = np.corrcoef(np.column_stack([K[:, :PHASE], d, K[:, PHASE + 1 :]]), rowvar=False)
     corr = np.where(np.isfinite(corr), corr, np.nan)

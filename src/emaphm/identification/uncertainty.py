@@ -12,7 +12,8 @@ estimate k̂, at the cost of one population call of 33 rows (≈ 1 % of an ident
    window, c = 5). The filtered residual is strongly autocorrelated (τ ≈ 30–140 samples):
    taken as independent, the samples would make the variances τ times too small.
 3. J = ∂r/∂u by central differences at h = 10⁻³ and 3·10⁻³ (one-sided at a bound of the box).
-4. Cov_u = τ·s²·(JᵀJ)⁺, carried to k by the delta method (σ_raw). A parameter whose σ differs by
+4. Cov_u = (JᵀJ)⁺·M·(JᵀJ)⁺, M the Newey–West long-run covariance of the scores over 5 τ
+   (`sandwich`), carried to k by the delta method (σ_raw). A parameter whose σ differs by
    more than 50 % between the two steps is flagged ``nonsmooth`` (friction and backlash make the
    fitness non-smooth) and takes the larger.
 5. Noise alone does not make the error: the monitor's discrepancy from the actuator biases every
@@ -73,6 +74,7 @@ NONSMOOTH_RATIO = 1.5  # σ differing by more than this between the two steps: n
 NON_IDENTIFIABLE = 1e-6  # eigenvalue of JᵀJ below this fraction of the largest
 PHASE_SIGMAS = 2.0  # the direction is undefined while ζ̂ < this many σ(ζ)
 SOKAL_C = 5.0  # Sokal's window: the smallest M with M ≥ c·τ(M)
+PINV_RCOND = 1e-12  # directions of JᵀJ below this fraction of the largest are dropped (σ → ∞)
 HAC_TAUS = 5.0  # the sandwich's Bartlett window spans this many autocorrelation times
 N_PARAMS = len(FAULT_NAMES)
 ZETA, PHASE = 5, 6  # indices of k6 (ζ) and k7 (its direction) in the fault vector
@@ -197,6 +199,8 @@ def load_factors(path: str | os.PathLike[str] | None = None) -> Factors:
         data = json.loads(p.read_text())
     except FileNotFoundError:
         raise InputError(f"{p}: no such interval calibration file") from None
+    except OSError as exc:
+        raise InputError(f"{p}: cannot read the interval calibration ({exc.strerror or exc})") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{p} is not a JSON interval calibration ({exc})") from None
     return Factors.from_json(data, str(p))
@@ -215,7 +219,7 @@ class Uncertainty:
     raw_std: NDArray[np.float64]  # σ before the discrepancy calibration
     evaluations: int
     details: dict[str, Any] = field(default_factory=dict)
-    cov_u: NDArray[np.float64] | None = None  # Cov of u = (k1..k5, e_x, e_y, k8), noise only (τ-scaled)
+    cov_u: NDArray[np.float64] | None = None  # Cov of u = (k1..k5, e_x, e_y, k8), noise only (`sandwich`)
 
     def half_width(self) -> NDArray[np.float64]:
         """Half the length of each 90 % interval (k7: of its arc)."""
@@ -228,6 +232,15 @@ class Uncertainty:
         def values(a: NDArray[np.float64]) -> list[Any]:
             return [float(v) if np.isfinite(v) else None for v in np.ravel(a)]
 
+        def clean(x: Any) -> Any:  # JSON has no NaN or inf: null
+            if isinstance(x, dict):
+                return {k: clean(v) for k, v in x.items()}
+            if isinstance(x, (list, tuple)):
+                return [clean(v) for v in x]
+            if isinstance(x, (float, np.floating)):
+                return float(x) if np.isfinite(x) else None
+            return x
+
         return {
             "uq_method": self.method,
             "std": values(self.std),
@@ -235,7 +248,7 @@ class Uncertainty:
             "ci90_high": values(self.ci90_high),
             "corr": [values(row) for row in self.corr],
             "uq_flags": [list(f) for f in self.flags],
-            "uq": {"raw_std": values(self.raw_std), "evaluations": self.evaluations, **self.details},
+            "uq": clean({"raw_std": values(self.raw_std), "evaluations": self.evaluations, **self.details}),
         }
 
 
@@ -293,7 +306,7 @@ def sandwich(J: NDArray[np.float64], r: NDArray[np.float64], tau: float) -> NDAr
     The weights of eq. (3) differ from sample to sample (they follow the slope of the current),
     so the weighted residual is not of one variance, and it is autocorrelated: τ·s²·(JᵀJ)⁻¹
     (valid for equal variances) covered 50-60 % instead of 90 % on a linear-Gaussian oracle
-    through the comparison filter; the sandwich covers 90 % (tests/identification/test_uncertainty.py).
+    through the comparison filter; the sandwich 78-85 % (tests/identification/test_uncertainty.py).
     """
     n = len(r)
     g = J * r[:, None]
@@ -304,7 +317,7 @@ def sandwich(J: NDArray[np.float64], r: NDArray[np.float64], tau: float) -> NDAr
     smoothed = fftconvolve(g, kernel[:, None], mode="same", axes=0)
     meat = g.T @ smoothed
     meat = (meat + meat.T) / 2
-    bread = np.linalg.pinv(J.T @ J, rcond=1e-12, hermitian=True)
+    bread = np.linalg.pinv(J.T @ J, rcond=PINV_RCOND, hermitian=True)
     return bread @ meat @ bread  # type: ignore[no-any-return]
 
 
@@ -373,18 +386,27 @@ def laplace(
             ok_p, ok_m = np.all(np.isfinite(rp)), np.all(np.isfinite(rm))
             span = spans[q * N_PARAMS + j]
             if ok_p and ok_m and span > 0:
-                J[:, j] = (rm - rp) / span  # r = ref − model: ∂r/∂u = −∂model/∂u
+                J[:, j] = (rm - rp) / span  # −∂r/∂u = ∂model/∂u (the sign cancels in the sandwich)
             elif ok_p or ok_m:  # one side diverged: a one-sided difference from the centre
-                J[:, j] = (r0 - rp) / (span / 2) if ok_p else (rm - r0) / (span / 2)
+                up_by, down_by = rows[i][j] - u0[j], u0[j] - rows[i + 1][j]  # the real distances
+                if ok_p and up_by > 0:
+                    J[:, j] = (r0 - rp) / up_by
+                elif ok_m and down_by > 0:
+                    J[:, j] = (rm - r0) / down_by
+                else:
+                    J[:, j] = 0.0
             else:
                 J[:, j] = 0.0
         JtJ = J.T @ J
-        cov_u = sandwich(J, r0, tau)
+        cov_u = sandwich(J, r0, tau)  # pinv at `PINV_RCOND`
         cov_k = _delta_to_faults(u0, cov_u)
         covs.append((JtJ, cov_k, J))
         sds.append(np.sqrt(np.clip(np.diag(cov_k), 0.0, np.inf)))
     JtJ, cov_k, _ = covs[0]
     raw = np.fmax(sds[0], sds[1])
+    # a direction JᵀJ's pseudo-inverse dropped (or a column no step could measure): its members'
+    # σ is unknown, not small; they get the whole box and can never be reported present
+    w_all = np.linalg.eigvalsh(covs[0][0])
     flags_extra: list[list[str]] = [[] for _ in range(N_PARAMS)]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.fmax(sds[0], sds[1]) / np.fmin(sds[0], sds[1])
@@ -398,6 +420,8 @@ def laplace(
         if ZETA in members or PHASE in members:
             members = sorted(set(members) | {ZETA, PHASE})
         combos.append([FAULT_NAMES[j] for j in members])
+        if w[e] <= PINV_RCOND * max(float(w_all[-1]), 1e-300):
+            raw[members] = np.inf
         for j in members:
             if "non_identifiable" not in flags_extra[j]:
                 flags_extra[j].append("non_identifiable")
@@ -463,7 +487,10 @@ def fit_factors(
                 if cov >= coverage and (best is None or width < best[2]):
                     best = (float(c), float(b), width, cov)
         if best is None:
-            best = (float(scales[-1]), float(floors[-1]), float("nan"), float("nan"))
+            raise InputError(
+                f"no scale and floor up to {scales[-1]:g} and {floors[-1]:g} make the intervals of "
+                f"{FAULT_NAMES[j]} cover {coverage:.0%} of these cases: are the estimates from this monitor?"
+            )
         scale[j], floor[j] = best[0], best[1]
         report[FAULT_NAMES[j]] = {"coverage": round(best[3], 4), "median_half_width": round(best[2], 5)}
     return Factors(scale, floor), report
