@@ -278,6 +278,8 @@ def test_non_finite_details_become_null_in_json():
     from emaphm.identification.uncertainty import Uncertainty
 
     s = np.full(8, 0.01)
-    u = Uncertainty("mcmc", s, s, s, np.eye(8), [[] for _ in range(8)], s, 0, {"autocorr_time": [np.nan, 3.0]})
+    u = Uncertainty(
+        "mcmc", s, s, s, np.eye(8), [[] for _ in range(8)], s, 0, {"autocorr_time": [np.nan, 3.0]}
+    )
     assert u.to_json()["uq"]["autocorr_time"] == [None, 3.0]
     json.dumps(u.to_json(), allow_nan=False)
