@@ -7,7 +7,8 @@ filter on the same time grid before they are compared:
   (`scipy.signal.sosfiltfilt`): zero phase, so no lag between the signals; it keeps the 1θ_e and
   2θ_e fault harmonics (≤ 80 Hz on the FDI chirp) and removes the hysteresis ripple (kHz).
 - **grid**: the LF model's sample grid t_k = k/f_s; a reference trace on another grid is
-  interpolated onto it (`Comparison.from_trace`).
+  interpolated onto it (`Comparison.from_trace`, `resample`), after an anti-aliasing low-pass on
+  its own grid when it is sampled faster.
 - **NRMSE** (the calibration objective and the LF-vs-HF figure of merit):
 
       NRMSE = ‖I_ref − I‖₂ ⁄ ‖I_ref − mean(I_ref)‖₂          (both filtered)
@@ -26,7 +27,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from ..errors import InputError
 
-__all__ = ["CUTOFF_HZ", "FILTER_ORDER", "Comparison", "lowpass", "nrmse"]
+__all__ = ["CUTOFF_HZ", "FILTER_ORDER", "Comparison", "lowpass", "nrmse", "resample"]
 
 CUTOFF_HZ = 150.0
 FILTER_ORDER = 2
@@ -44,6 +45,40 @@ def nrmse(reference: ArrayLike, estimate: ArrayLike, *, axis: int = -1) -> NDArr
     est = np.asarray(estimate, dtype=np.float64)
     scale = np.linalg.norm(ref - ref.mean(axis=axis, keepdims=True), axis=axis)
     return np.linalg.norm(est - ref, axis=axis) / scale  # type: ignore[no-any-return]
+
+
+# a source sampled faster than this many times the model grid is low-passed on its own grid first
+ANTI_ALIAS_ABOVE = 1.1
+ANTI_ALIAS_ORDER = 8
+ANTI_ALIAS_FRACTION = 0.4  # of the model grid's rate: 4 kHz for 10 kHz, below its Nyquist
+
+
+def resample(t_src: ArrayLike, x_src: ArrayLike, t_grid: ArrayLike, f_s: float) -> NDArray[np.float64]:
+    """A signal sampled at t_src [s] on the model grid t_grid (rate f_s [Hz]), by linear interpolation.
+
+    A source sampled faster than the grid (by more than `ANTI_ALIAS_ABOVE`, on a uniform grid) is
+    first low-passed on its own grid (zero-phase Butterworth, order 8, at 0.4·f_s): interpolating
+    first would fold the inverter's ripple above the grid's Nyquist rate into the comparison band
+    (issue 10; `benchmarks/bench_resample.py` measures it). A source at the grid's rate or
+    slower is interpolated as it is, so a trace on the model grid comes through unchanged.
+    """
+    t_src = np.asarray(t_src, dtype=np.float64)
+    x = np.asarray(x_src, dtype=np.float64)
+    t_grid = np.asarray(t_grid, dtype=np.float64)
+    if t_grid[0] < t_src[0] - 1e-12 or t_grid[-1] > t_src[-1] + 1e-12:
+        raise InputError(
+            f"the trace covers {t_src[0]:g}..{t_src[-1]:g} s, the model needs {t_grid[0]:g}..{t_grid[-1]:g} s"
+        )
+    dt = np.diff(t_src)
+    if len(dt) > 0 and np.all(dt > 0):
+        step = float(np.median(dt))
+        uniform = bool(np.max(np.abs(dt - step)) <= 1e-3 * step)
+        f_src = 1.0 / step
+        if uniform and f_src > ANTI_ALIAS_ABOVE * f_s:
+            sos = butter(ANTI_ALIAS_ORDER, ANTI_ALIAS_FRACTION * f_s, fs=f_src, output="sos")
+            if len(x) > 3 * (2 * len(sos) + 1):  # sosfiltfilt's default padding
+                x = sosfiltfilt(sos, x)
+    return np.interp(t_grid, t_src, x)
 
 
 @dataclass(frozen=True)
@@ -75,14 +110,10 @@ class Comparison:
 
     @classmethod
     def from_trace(cls, t_src: ArrayLike, i_q_src: ArrayLike, t_grid: ArrayLike, f_s: float) -> Comparison:
-        """From a trace on its own grid: linear interpolation onto the model grid, then the filter."""
-        t_src = np.asarray(t_src, dtype=np.float64)
-        t_grid = np.asarray(t_grid, dtype=np.float64)
-        if t_grid[0] < t_src[0] - 1e-12 or t_grid[-1] > t_src[-1] + 1e-12:
-            raise InputError(
-                f"the trace covers {t_src[0]:g}..{t_src[-1]:g} s, the model needs {t_grid[0]:g}..{t_grid[-1]:g} s"
-            )
-        return cls.from_signal(t_grid, np.interp(t_grid, t_src, np.asarray(i_q_src, dtype=np.float64)), f_s)
+        """From a trace on its own grid: onto the model grid (`resample`), then the filter."""
+        return cls.from_signal(
+            np.asarray(t_grid, dtype=np.float64), resample(t_src, i_q_src, t_grid, f_s), f_s
+        )
 
     def filtered(self, currents: ArrayLike) -> NDArray[np.float64]:
         """Model currents (shape (n,) or (m, n)) through the same filter."""
