@@ -194,40 +194,12 @@ def identify(
 
 
 def _print_identification(data: dict[str, Any]) -> None:
-    from rich.table import Table
+    from .tables import fault_table
 
     title = f"identified faults ({data['optimizer']}, seed {data['seed']}"
     title += f", 90 % intervals by {data['uq_method']})" if data["ci90_low"] is not None else ")"
-    table = Table(title=title)
-    columns = ["fault", "identified"]
-    if data["ci90_low"] is not None:
-        columns += ["± half-width", "90 % interval", "flags"]
-    if data["truth"] is not None:
-        columns.append("true")
-    columns.append("verdict")
-    for name in columns:
-        table.add_column(name, justify="left" if name in ("fault", "flags", "verdict") else "right")
+    table = fault_table(data, title)
     verdicts = data.get("fault_verdicts") or {}
-    for i, name in enumerate(data["fault_names"]):
-        row = [f"k{i + 1} {name}", f"{data['estimate'][i]:.4f}"]
-        if data["ci90_low"] is not None:
-            lo, hi = data["ci90_low"][i], data["ci90_high"][i]
-            whole = name == "eccentricity_phase" and lo == 0.0 and hi == 1.0
-            half = 0.5 if whole else ((hi - lo) % 1.0 if name == "eccentricity_phase" else hi - lo) / 2
-            row += [
-                f"{half:.4f}",
-                "whole circle" if whole else f"[{lo:.4f}, {hi:.4f}]",
-                " ".join(data["uq_flags"][i]),
-            ]
-        if data["truth"] is not None:
-            row.append(f"{data['truth'][i]:.4f}")
-        if data["verdict"] != "fits":
-            row.append("-")
-        elif verdicts:
-            row.append(verdicts.get(name, "(direction)"))
-        else:
-            row.append("present" if name in data["detected"] else "-")
-        table.add_row(*row)
     out = _stdout_console()
     out.print(table)
     if data["percent_error"] is not None:

@@ -26,42 +26,16 @@ from .calibration import Calibration
 from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
 from .identification.detection import detect
-from .identification.identify import IdentificationResult, identify
+from .identification.identify import identify
 from .identification.metrics import percent_error
 from .identification.optimizers import check_optimizer
 from .models import MonitorEma, check_seed, simulate
 from .plots import plot_convergence, plot_fit, plot_response, plot_vectors
+from .tables import fault_table
 
-__all__ = ["PAPER_TABLE1_PERCENT_ERR", "diagnosis_table", "run_demo"]
+__all__ = ["PAPER_TABLE1_PERCENT_ERR", "run_demo"]
 
 PAPER_TABLE1_PERCENT_ERR = (4.46, 4.67, 4.16, 4.96, 4.93)  # the paper's Table 1, for comparison
-
-
-def diagnosis_table(result: IdentificationResult, truth: np.ndarray | None, *, title: str) -> Table:
-    """Each fault as value ± half-width of its 90 % interval, the interval, flags and verdict."""
-    assert result.uncertainty is not None
-    u = result.uncertainty
-    half = u.half_width()
-    verdicts = result.fault_verdicts or {}
-    table = Table(title=title)
-    for name in (
-        "fault",
-        "identified",
-        "90 % interval",
-        "flags",
-        *(("true",) if truth is not None else ()),
-        "verdict",
-    ):
-        table.add_column(name, justify="left" if name in ("fault", "flags", "verdict") else "right")
-    for i, name in enumerate(FAULT_NAMES):
-        whole = i == 6 and u.ci90_low[i] == 0.0 and u.ci90_high[i] == 1.0
-        span = "whole circle" if whole else f"[{u.ci90_low[i]:.4f}, {u.ci90_high[i]:.4f}]"
-        row = [f"k{i + 1} {name}", f"{result.estimate[i]:.4f} ± {half[i]:.4f}", span, " ".join(u.flags[i])]
-        if truth is not None:
-            row.append(f"{truth[i]:.4f}")
-        row.append(verdicts.get(name, "(direction)"))
-        table.add_row(*row)
-    return table
 
 
 def run_demo(
@@ -144,9 +118,8 @@ def run_demo(
     best_at = int(np.argmin([r.fitness for r in results]))
     best = results[best_at]
     if best.uncertainty is not None:
-        console.print(
-            diagnosis_table(best, truth, title=f"Diagnosis of the best-fitting run (seed {best_at + 1})")
-        )
+        shown = {**best.to_json(), "truth": truth.tolist()}  # the demo knows the truth of its measurement
+        console.print(fault_table(shown, f"Diagnosis of the best-fitting run (seed {best_at + 1})"))
 
     output_dir.mkdir(parents=True, exist_ok=True)
     lf = monitor_model.simulate(best.estimate)

@@ -168,21 +168,14 @@ def summarise(
         if j == PHASE:
             continue
         c, b = factors.scale[j], factors.floor[j]
-        if "at_bound" in flags[j]:
-            edge = hi[j] if lo[j] == 0.0 else lo[j]
-            grow = np.sqrt((c * abs(edge - centre[j])) ** 2 + (Z90 * b) ** 2)
-            if lo[j] == 0.0:
-                hi[j] = min(centre[j] + grow, 1.0)
-            else:
-                lo[j] = max(centre[j] - grow, 0.0)
-        else:
-            for side in (-1, 1):
-                edge = lo[j] if side < 0 else hi[j]
-                grow = np.sqrt((c * abs(edge - centre[j])) ** 2 + (Z90 * b) ** 2)
-                if side < 0:
-                    lo[j] = max(centre[j] - grow, 0.0)
-                else:
-                    hi[j] = min(centre[j] + grow, 1.0)
+        # the edge at the bound of a one-sided interval stays where it is
+        fixed_lo = "at_bound" in flags[j] and lo[j] == 0.0
+        fixed_hi = "at_bound" in flags[j] and not fixed_lo
+        grow_lo, grow_hi = (np.sqrt((c * abs(e - centre[j])) ** 2 + (Z90 * b) ** 2) for e in (lo[j], hi[j]))
+        if not fixed_lo:
+            lo[j] = max(centre[j] - grow_lo, 0.0)
+        if not fixed_hi:
+            hi[j] = min(centre[j] + grow_hi, 1.0)
         std[j] = float(np.sqrt((c * std[j]) ** 2 + b**2))
     q5, q95 = np.quantile(d, [0.05, 0.95])
     half = np.sqrt((factors.scale[PHASE] * max(-q5, q95)) ** 2 + (Z90 * factors.floor[PHASE]) ** 2)

@@ -56,6 +56,7 @@ __all__ = [
     "Uncertainty",
     "covers",
     "fit_factors",
+    "half_widths",
     "integrated_time",
     "intervals",
     "laplace",
@@ -223,10 +224,7 @@ class Uncertainty:
 
     def half_width(self) -> NDArray[np.float64]:
         """Half the length of each 90 % interval (k7: of its arc)."""
-        width = self.ci90_high - self.ci90_low
-        whole = self.ci90_low[PHASE] == 0.0 and self.ci90_high[PHASE] == 1.0
-        width[PHASE] = 1.0 if whole else np.mod(width[PHASE], 1.0)
-        return width / 2.0  # type: ignore[no-any-return]
+        return half_widths(self.ci90_low, self.ci90_high)
 
     def to_json(self) -> dict[str, Any]:
         def values(a: NDArray[np.float64]) -> list[Any]:
@@ -250,6 +248,16 @@ class Uncertainty:
             "uq_flags": [list(f) for f in self.flags],
             "uq": clean({"raw_std": values(self.raw_std), "evaluations": self.evaluations, **self.details}),
         }
+
+
+def half_widths(low: ArrayLike, high: ArrayLike) -> NDArray[np.float64]:
+    """Half the length of each interval (rows of (m, 8) or one row); k7 (column 6) of its arc on
+    the circle, where low > high runs through 0 and [0, 1] is the whole circle (0.5)."""
+    lo, hi = (np.asarray(a, dtype=np.float64) for a in (low, high))
+    width = hi - lo
+    whole = (lo[..., PHASE] == 0.0) & (hi[..., PHASE] == 1.0)
+    width[..., PHASE] = np.where(whole, 1.0, np.mod(width[..., PHASE], 1.0))
+    return width / 2.0  # type: ignore[no-any-return]
 
 
 def covers(low: ArrayLike, high: ArrayLike, truth: ArrayLike) -> NDArray[np.bool_]:
@@ -397,16 +405,12 @@ def laplace(
                     J[:, j] = 0.0
             else:
                 J[:, j] = 0.0
-        JtJ = J.T @ J
         cov_u = sandwich(J, r0, tau)  # pinv at `PINV_RCOND`
         cov_k = _delta_to_faults(u0, cov_u)
-        covs.append((JtJ, cov_k, J))
+        covs.append((J.T @ J, cov_k, cov_u))
         sds.append(np.sqrt(np.clip(np.diag(cov_k), 0.0, np.inf)))
-    JtJ, cov_k, _ = covs[0]
+    JtJ, cov_k, cov_u = covs[0]
     raw = np.fmax(sds[0], sds[1])
-    # a direction JᵀJ's pseudo-inverse dropped (or a column no step could measure): its members'
-    # σ is unknown, not small; they get the whole box and can never be reported present
-    w_all = np.linalg.eigvalsh(covs[0][0])
     flags_extra: list[list[str]] = [[] for _ in range(N_PARAMS)]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.fmax(sds[0], sds[1]) / np.fmin(sds[0], sds[1])
@@ -420,7 +424,9 @@ def laplace(
         if ZETA in members or PHASE in members:
             members = sorted(set(members) | {ZETA, PHASE})
         combos.append([FAULT_NAMES[j] for j in members])
-        if w[e] <= PINV_RCOND * max(float(w_all[-1]), 1e-300):
+        # a direction the pseudo-inverse dropped (or a column no step could measure): its members'
+        # σ is unknown, not small; they get the whole box and can never be reported present
+        if w[e] <= PINV_RCOND * max(float(w[-1]), 1e-300):
             raw[members] = np.inf
         for j in members:
             if "non_identifiable" not in flags_extra[j]:
@@ -444,7 +450,6 @@ def laplace(
         "non_identifiable": combos,
         "calibrated": bool(factors.record),
     }
-    cov_u = sandwich(covs[0][2], r0, tau)
     return Uncertainty("laplace", std, lo, hi, corr, flags, raw, len(rows), details, cov_u)
 
 
@@ -468,24 +473,18 @@ def fit_factors(
     floors = np.concatenate([[0.0], np.geomspace(1e-4, 0.2, 60)])
     scale, floor = np.ones(N_PARAMS), np.zeros(N_PARAMS)
     report: dict[str, Any] = {}
-    for j in [*range(N_PARAMS)]:  # ζ before its direction: the direction's definition needs ζ's σ
+    for j in range(N_PARAMS):  # ζ before its direction: the direction's definition needs ζ's σ
         best: tuple[float, float, float, float] | None = None
-        for c in scales:
-            for b in floors:
-                trial_s, trial_b = scale.copy(), floor.copy()
-                trial_s[j], trial_b[j] = c, b
-                std = Factors(trial_s, trial_b).apply(S)
-                _, lo, hi, _ = intervals(E, std, with_flags=False)
-                rows = T[:, ZETA] >= 0.05 if j == PHASE else np.ones(len(E), dtype=bool)
-                if not rows.any():
-                    continue
-                inside = covers(lo, hi, T)[rows, j]
-                half = (hi - lo)[rows, j] / 2.0
-                if j == PHASE:
-                    half = np.where(hi[rows, j] == 1.0, 0.5, np.mod(hi[rows, j] - lo[rows, j], 1.0) / 2.0)
-                cov, width = float(inside.mean()), float(np.median(half))
-                if cov >= coverage and (best is None or width < best[2]):
-                    best = (float(c), float(b), width, cov)
+        rows = T[:, ZETA] >= 0.05 if j == PHASE else np.ones(len(E), dtype=bool)
+        grid = [(c, b) for c in scales for b in floors] if rows.any() else []  # no case to score: none
+        for c, b in grid:
+            trial_s, trial_b = scale.copy(), floor.copy()
+            trial_s[j], trial_b[j] = c, b
+            _, lo, hi, _ = intervals(E, Factors(trial_s, trial_b).apply(S), with_flags=False)
+            cov = float(covers(lo, hi, T)[rows, j].mean())
+            width = float(np.median(half_widths(lo, hi)[rows, j]))
+            if cov >= coverage and (best is None or width < best[2]):
+                best = (float(c), float(b), width, cov)
         if best is None:
             raise InputError(
                 f"no scale and floor up to {scales[-1]:g} and {floors[-1]:g} make the intervals of "
