@@ -64,7 +64,7 @@ def test_bad_paths_exit_2_in_one_line_before_the_work(tmp_path, capsys, monkeypa
     (tmp_path / "header.csv").write_text("t,theta_cmd,theta_u,i_q\n")
     other = default_calibration()
     params = dict(other.record["settings"]["params"])
-    params["transmission"] = {**params["transmission"], "J_m": 1e-4}
+    params["motor"] = {**params["motor"], "R_s": 0.6}  # another actuator, same nameplate k_t, k_e, J
     record = {**other.record, "settings": {**other.record["settings"], "params": params}}
     dataclasses.replace(other, record=record).save(tmp_path / "other.json")
     before = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*"))

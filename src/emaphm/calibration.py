@@ -25,20 +25,20 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ._data import read_package_json
 from .errors import InputError
-
-if TYPE_CHECKING:
-    from .params import EmaParams
+from .params import EmaParams
 
 __all__ = [
     "COEFFICIENT_BOUNDS",
+    "NAMEPLATE_SCALED",
     "Calibration",
     "Coefficients",
     "actuator_params",
     "check_monitor",
+    "coefficient_bounds",
     "default_calibration",
     "load_calibration",
     "params_hash",
@@ -102,11 +102,34 @@ class Coefficients:
     V_H: float = 0.01
 
     def __post_init__(self) -> None:
+        # the nameplate-scaled coefficients are checked against their actuator's box by
+        # `check_bounds`; here only that they are positive
         for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi):
+            if name in NAMEPLATE_SCALED:
+                lo, hi = 0.0, math.inf
+                ok = isinstance(v, (int, float)) and math.isfinite(v) and v > 0
+            else:
+                ok = isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi
+            if not ok:
                 raise InputError(
                     f"calibration coefficient {name}={v!r} is outside its range [{lo:g}, {hi:g}]"
+                )
+
+    @classmethod
+    def first_guess(cls, params: EmaParams | None = None) -> Coefficients:
+        """The coefficients before calibration for an actuator: the defaults with its nameplate k_t, k_e, J."""
+        nominal, ratio = cls(), _nameplate_ratios(params)
+        return cls(**{name: getattr(nominal, name) * r for name, r in ratio.items()})
+
+    def check_bounds(self, params: EmaParams | None = None, *, where: str = "calibration") -> None:
+        """`InputError` unless every coefficient lies in `coefficient_bounds(params)`."""
+        for name, (lo, hi) in coefficient_bounds(params).items():
+            v = getattr(self, name)
+            if not lo <= v <= hi:
+                raise InputError(
+                    f"{where}: coefficient {name}={v!r} is outside its range [{lo:.4g}, {hi:.4g}]"
+                    + (" for these actuator parameters" if name in NAMEPLATE_SCALED else "")
                 )
 
     @property
@@ -125,6 +148,36 @@ class Coefficients:
     @classmethod
     def from_vector(cls, x: Any) -> Coefficients:
         return cls(**{n: float(v) for n, v in zip(COEFFICIENT_BOUNDS, x, strict=True)})
+
+
+# the coefficients whose search box scales with the actuator's nameplate value (k_t = 1.5·p·ψ_m,
+# k_e = p·ψ_m, J = J_m + J_u/τ²): COEFFICIENT_BOUNDS holds their box for the nominal actuator
+NAMEPLATE_SCALED = ("k_t_eq", "k_e_eq", "J_eq")
+
+
+def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float, float]]:
+    """The calibration's search box for an actuator (`COEFFICIENT_BOUNDS` for the nominal one).
+
+    k_t,eq, k_e,eq and J_eq keep the nominal box's ratios to the nameplate k_t, k_e and J, so a
+    motor with twice the flux, say, is searched around its own constants; the dimensionless shape
+    coefficients and the loop surrogate keep their boxes.
+    """
+    ratio = _nameplate_ratios(params)
+    return {
+        name: (lo * ratio[name], hi * ratio[name]) if name in ratio else (lo, hi)
+        for name, (lo, hi) in COEFFICIENT_BOUNDS.items()
+    }
+
+
+def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
+    """k_t, k_e and J of `params` over the nominal actuator's (exactly 1 for the nominal one)."""
+    nominal = EmaParams()
+    params = params if params is not None else nominal
+    return {
+        "k_t_eq": params.motor.k_t / nominal.motor.k_t,
+        "k_e_eq": params.motor.k_e / nominal.motor.k_e,
+        "J_eq": params.transmission.J / nominal.transmission.J,
+    }
 
 
 def actuator_params(params: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -199,7 +252,8 @@ class Calibration:
             raise InputError(
                 f"{where} was made for other actuator parameters (hash {params_hash(made_for)}, these are "
                 f"{params_hash(params)}): {'; '.join(differ[:2])}{more}; "
-                "calibrate the monitor for them (emaphm.calibrate(params=...)) and pass that calibration"
+                "calibrate the monitor for them ('emaphm calibrate --params FILE --output cal.json', "
+                "or emaphm.calibrate(params=...)) and pass that calibration"
             )
 
     def to_json(self) -> dict[str, Any]:
@@ -270,8 +324,12 @@ def _parse(data: Any, where: str) -> Calibration:
     }
     try:
         cal = Calibration(Coefficients(**coeffs), n_lf, record)
+        recorded = cal.params
+        cal.coefficients.check_bounds(
+            None if recorded is None else EmaParams.from_dict(recorded), where=where
+        )
     except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
+        raise InputError(f"{where}: {exc}".replace(f"{where}: {where}: ", f"{where}: ")) from None
     if monitor == "paper" and any(getattr(cal.coefficients, n) != 0.0 for n in SURROGATE):
         raise InputError(
             f"{where}: a 'paper' monitor has no loop surrogate, but {', '.join(SURROGATE)} are not all 0"

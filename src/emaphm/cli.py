@@ -25,6 +25,7 @@ from ._version import __version__
 from .errors import InputError, SimulationError
 
 CALIBRATION_HELP = "LF calibration file from 'emaphm calibrate' (default: the packaged one)."
+PARAMS_HELP = "Actuator file (TOML, from 'emaphm params --template'); default: the paper's nominal actuator."
 MONITOR_HELP = (
     "Monitor model: 'default', or 'paper' (the paper's single-phase model, eqs. 1-2 alone); "
     "default: the calibration's."
@@ -87,8 +88,10 @@ def simulate(
         Path | None, typer.Option(help=CALIBRATION_HELP + " Only with --model lf.")
     ] = None,
     monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP + " Only with --model lf.")] = None,
+    params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
 ) -> None:
     """Simulate the actuator with a fault vector and write the sampled signals."""
+    from .actuator import resolve_params
     from .commands import make_command
     from .faults import describe, parse_faults
     from .io import TRACE_SUFFIXES, check_output_path, write_trace
@@ -96,8 +99,11 @@ def simulate(
 
     k = parse_faults(faults)
     check_seed(seed)
-    check_output_path(output, suffixes=TRACE_SUFFIXES, inputs=(calibration,))  # before the work
-    ema = make_model(model, command=make_command(command), calibration=calibration, monitor=monitor)
+    check_output_path(output, suffixes=TRACE_SUFFIXES, inputs=(calibration, params))  # before the work
+    ema = make_model(
+        model, params=resolve_params(params), command=make_command(command), calibration=calibration,
+        monitor=monitor,
+    )  # fmt: skip
     ema.sample_grid(duration)  # a duration no run can have: before the work
     with _status(f"simulating {model.upper()} twin ({describe(k)})"):
         result = ema.simulate(k, noise=noise, seed=seed, duration=duration)
@@ -143,6 +149,9 @@ def identify(
         Path | None,
         typer.Option(help="Interval calibration from 'emaphm calibrate-uq' (default: the packaged one)."),
     ] = None,
+    params: Annotated[
+        Path | None, typer.Option("--params", help=PARAMS_HELP + " Needs its --calibration.")
+    ] = None,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current."""
     import json
@@ -163,7 +172,9 @@ def identify(
     if reference is not None:
         check_trace_path(reference, for_writing=False)
     if output is not None:
-        check_output_path(output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration))
+        check_output_path(
+            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params)
+        )
     if uncertainty == "none" and uq_calibration is not None:
         raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
     if uncertainty != "none":
@@ -174,7 +185,7 @@ def identify(
         result = run_identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
             generations=generations, local_polish=polish, calibration=calibration, monitor=monitor,
-            uncertainty=uncertainty, uq_calibration=uq_calibration,
+            uncertainty=uncertainty, uq_calibration=uq_calibration, params=params,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
             ),
@@ -230,25 +241,31 @@ def calibrate(
     monitor: Annotated[
         str, typer.Option(help="Monitor model to calibrate: 'default', or 'paper' (eqs. 1-2 alone).")
     ] = "default",
+    params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
 ) -> None:
-    """Re-run the LF calibration against the HF twin and write the calibration file."""
+    """Re-run the LF calibration against the HF twin (of the actuator file) and write the calibration file."""
+    from .actuator import resolve_params
     from .identification.calibrate import calibrate as run_calibration
     from .io import check_output_path
     from .models import check_seed
 
     check_seed(seed)
-    check_output_path(output, suffixes=(".json",))
+    check_output_path(output, suffixes=(".json",), inputs=(params,))
+    actuator = resolve_params(params)
     with numba_threads(workers, name="--workers"), _progress() as update:
         cal = run_calibration(
-            monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update
-        )
+            monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update,
+            params=actuator,
+        )  # fmt: skip
     cal.save(output)
     for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
         values = [s["nrmse"] for s in cal.record[key]]
         err.print(
             f"{title}: NRMSE {100 * min(values):.1f} to {100 * max(values):.1f} % over {len(values)} scenarios"
         )
-    err.print(f"wrote {output} (seed {seed}, {cal.record['settings']['wall_time_s']:.0f} s)")
+    err.print(
+        f"wrote {output} (seed {seed}, actuator {cal.params_hash}, {cal.record['settings']['wall_time_s']:.0f} s)"
+    )
 
 
 @app.command("calibrate-uq")
@@ -261,8 +278,12 @@ def calibrate_uq(
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
     monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
     workers: Annotated[int, typer.Option(help="Threads for the population kernel (0: all cores).")] = 0,
+    params: Annotated[
+        Path | None, typer.Option("--params", help=PARAMS_HELP + " Needs its --calibration.")
+    ] = None,
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
+    from .actuator import resolve_params
     from .identification.calibrate_uq import calibrate_uq as run_calibrate_uq
     from .io import check_output_path
     from .models import MonitorEma, check_seed
@@ -270,8 +291,9 @@ def calibrate_uq(
     check_seed(seed)
     if cases < 20:
         raise InputError(f"--cases must be >= 20 (coverage needs a sample), got {cases}")
-    check_output_path(output, suffixes=(".json",), inputs=(calibration,))
-    MonitorEma(calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
+    check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
+    actuator = resolve_params(params)
+    MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
     with numba_threads(workers, name="--workers"), _progress() as update:
 
         def report(stage: str, done: int, total: int) -> None:
@@ -280,8 +302,9 @@ def calibrate_uq(
                 err.print(f"{done}/{total} {stage}")
 
         factors = run_calibrate_uq(
-            cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report
-        )
+            cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
+            params=actuator,
+        )  # fmt: skip
     factors.save(output)
     for name, fit in factors.record["training"].items():
         err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
@@ -320,14 +343,73 @@ def demo(
     runs: Annotated[int, typer.Option(help="Identifications (optimiser seeds 1..runs).")] = 5,
     calibration: Annotated[Path | None, typer.Option(help=CALIBRATION_HELP)] = None,
     monitor: Annotated[str | None, typer.Option(help=MONITOR_HELP)] = None,
+    params: Annotated[
+        Path | None, typer.Option("--params", help=PARAMS_HELP + " Needs its --calibration.")
+    ] = None,
 ) -> None:
     """The main job: the paper's Table 1 experiment (HF twin with noise, five identifications)."""
     from .demo import run_demo
 
     run_demo(
         output_dir, seed=seed, optimizer=optimizer, runs=runs, calibration=calibration, monitor=monitor,
-        console=_stdout_console(), status=_status,
+        console=_stdout_console(), status=_status, params=params,
     )  # fmt: skip
+
+
+@app.command("params")
+def params_command(
+    file: Annotated[Path | None, typer.Argument(help="An actuator file to check.")] = None,
+    template: Annotated[
+        bool,
+        typer.Option(
+            "--template",
+            help="Print a complete actuator file: every parameter with its unit and meaning "
+            "(the nominal values, or FILE's).",
+        ),
+    ] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the parameters as one JSON object.")
+    ] = False,
+) -> None:
+    """Write an actuator file (--template), or check one and show its parameters and their hash."""
+    import json
+
+    from .actuator import resolve_params
+    from .calibration import params_hash
+
+    if template and json_out:
+        raise InputError("give --template or --json, not both")
+    actuator = resolve_params(file)
+    if template:
+        from .actuator import params_template
+
+        typer.echo(params_template(actuator), nl=False)
+        return
+    if json_out:
+        typer.echo(json.dumps({"params": actuator.to_dict(), "params_hash": params_hash(actuator)}))
+        return
+    _print_params(actuator, str(file) if file is not None else "the nominal actuator")
+
+
+def _print_params(actuator: Any, source: str) -> None:
+    import dataclasses
+
+    from rich.table import Table
+
+    from .calibration import params_hash
+    from .params import EmaParams
+
+    nominal = EmaParams()
+    table = Table(title=f"{source} (hash {params_hash(actuator)})")
+    for column in ("block", "parameter", "value", "unit", "nominal", "meaning"):
+        table.add_column(column, justify="right" if column in ("value", "nominal") else "left")
+    for group in dataclasses.fields(actuator):
+        mine, theirs = getattr(actuator, group.name), getattr(nominal, group.name)
+        for f in dataclasses.fields(mine):
+            value, base = getattr(mine, f.name), getattr(theirs, f.name)
+            shown = f"{value:g}" if value == base else f"[bold]{value:g}[/bold]"
+            table.add_row(group.name, f.name, shown, f.metadata["unit"], f"{base:g}", f.metadata["doc"])
+    _stdout_console().print(table)
 
 
 def _fail(message: str, status: int) -> None:

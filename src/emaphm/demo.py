@@ -22,6 +22,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from .actuator import resolve_params
 from .calibration import Calibration
 from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
@@ -30,6 +31,7 @@ from .identification.identify import identify
 from .identification.metrics import percent_error
 from .identification.optimizers import check_optimizer
 from .models import MonitorEma, check_seed, simulate
+from .params import EmaParams
 from .plots import plot_convergence, plot_fit, plot_response, plot_vectors
 from .tables import fault_table
 
@@ -49,11 +51,13 @@ def run_demo(
     console: Console | None = None,
     status: Callable[[str], Any] | None = None,
     budget: dict[str, Any] | None = None,
+    params: EmaParams | str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run the Table 1 experiment; print its table, write its figures, return its figures.
 
     `calibration` is the LF calibration (default: the packaged one of `monitor`, "default" or
-    "paper"); `budget` passes
+    "paper"); `params` the actuator (`EmaParams` or an actuator file; its calibration must be
+    given too, see `emaphm.actuator`); `budget` passes
     ``pop_size``, ``generations`` and ``local_polish`` to `identify` (the defaults otherwise:
     tests use a small one).
     """
@@ -68,15 +72,18 @@ def run_demo(
         raise InputError(f"runs must be >= 1, got {runs}")
     check_optimizer(optimizer)
     check_seed(seed)
-    monitor_model = MonitorEma(calibration=calibration, monitor=monitor)  # refused now if it does not fit
+    actuator = resolve_params(params)
+    monitor_model = MonitorEma(
+        actuator, calibration=calibration, monitor=monitor
+    )  # refused now if it does not fit
 
     def stage(message: str) -> Any:
         return status(message) if status else nullcontext()
 
     truth = np.array(TABLE1_REFERENCE)
     with stage("simulating the actuator (HF twin, Table 1 faults, noise on)"):
-        measured = simulate(truth, noise=True, seed=seed)
-        healthy = simulate(HEALTHY, noise=True, seed=seed)
+        measured = simulate(truth, noise=True, seed=seed, params=actuator)
+        healthy = simulate(HEALTHY, noise=True, seed=seed, params=actuator)
     results = []
     for run_seed in range(1, runs + 1):
         with stage(f"identification {run_seed}/{runs} ({optimizer.upper()}, seed {run_seed})"):
@@ -86,6 +93,7 @@ def run_demo(
                     optimizer=optimizer,
                     seed=run_seed,
                     calibration=monitor_model.calibration,
+                    params=actuator,
                     **(budget or {}),
                 )
             )

@@ -1,9 +1,10 @@
 """Calibration of the LF monitor model against the HF twin (paper §4.2, DESIGN §4.4).
 
 A real-coded GA (pymoo, seeded) searches the coefficients of `emaphm.calibration.Coefficients`
-within `COEFFICIENT_BOUNDS` to minimise the mean NRMSE (see `signals`) between the filtered HF
-i_q and the filtered LF current over the fitting scenarios. One generation is one call of the
-population kernel: every candidate × every scenario is one row. The result is checked on
+within `coefficient_bounds(params)` (`COEFFICIENT_BOUNDS` scaled to the actuator's nameplate) to
+minimise the mean NRMSE (see `signals`) between the filtered HF i_q and the filtered LF current
+over the fitting scenarios. One generation is one call of the population kernel: every
+candidate × every scenario is one row. The result is checked on
 scenarios not used for fitting and written, with that record, to a versioned calibration file.
 """
 
@@ -22,7 +23,7 @@ from pymoo.algorithms.soo.nonconvex.ga import GA
 
 from .._version import __version__
 from .._versions import versions
-from ..calibration import COEFFICIENT_BOUNDS, SURROGATE, Calibration, Coefficients, check_monitor
+from ..calibration import SURROGATE, Calibration, Coefficients, check_monitor, coefficient_bounds
 from ..commands import Chirp, ChirpHold, Command, Steps, command_record
 from ..errors import InputError
 from ..faults import HEALTHY, as_fault_vector, random_faults
@@ -251,8 +252,10 @@ def calibrate(
         check, params, noise=True, seed=seed, progress=progress, commands=commands
     )
     # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
-    free = [n for n in COEFFICIENT_BOUNDS if not (paper and (n in SURROGATE or n == "V_H"))]
-    fixed = dataclasses.asdict(Coefficients())
+    bounds = coefficient_bounds(params)
+    free = [n for n in bounds if not (paper and (n in SURROGATE or n == "V_H"))]
+    first_guess = Coefficients.first_guess(params)
+    fixed = dataclasses.asdict(first_guess)
 
     def coefficients(x: NDArray[np.float64]) -> Coefficients:
         return Coefficients(**{**fixed, **{n: float(v) for n, v in zip(free, x, strict=True)}})
@@ -267,7 +270,7 @@ def calibrate(
             progress("GA generations", generation, total)
 
     # the mean NRMSE over the fitting scenarios as a function of the coefficient vector
-    lo, hi = zip(*(COEFFICIENT_BOUNDS[n] for n in free), strict=True)
+    lo, hi = zip(*(bounds[n] for n in free), strict=True)
     problem = BatchProblem(objective, lo, hi)
     # a fixed number of generations: no early stop
     x, _, history = minimize_batch(
@@ -277,9 +280,7 @@ def calibrate(
     fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands)[0]
     check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands)[0]
     check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf, commands)[0]
-    start_nrmse = scenario_nrmse(
-        [Coefficients()], fit + check, fit_refs + check_refs, params, n_lf, commands
-    )[0]
+    start_nrmse = scenario_nrmse([first_guess], fit + check, fit_refs + check_refs, params, n_lf, commands)[0]
 
     def table(scenarios: Sequence[Scenario], values: NDArray[np.float64]) -> list[dict[str, Any]]:
         return [
@@ -306,7 +307,7 @@ def calibrate(
             "objective": "mean NRMSE over the fitting scenarios (HF noise off)",
             "nrmse": "||I_HF - I_LF|| / ||I_HF - mean(I_HF)||, both filtered",
             "filter": f"Butterworth order {FILTER_ORDER}, {CUTOFF_HZ:g} Hz, zero phase (sosfiltfilt)",
-            "bounds": {k: list(v) for k, v in COEFFICIENT_BOUNDS.items()},
+            "bounds": {k: list(v) for k, v in bounds.items()},
             "fitted": free,
             # the first is the main one (the FDI chirp); every command fitted or checked is listed
             "command": command_record(commands[next(iter(used))]),
@@ -319,7 +320,7 @@ def calibrate(
         "check_scenarios": table(check, check_nrmse),
         "check_scenarios_noise_on": table(check, check_noisy),
         "before_calibration": {
-            "coefficients": dataclasses.asdict(Coefficients()),
+            "coefficients": dataclasses.asdict(first_guess),
             "scenarios": table(fit + check, start_nrmse),
         },
     }

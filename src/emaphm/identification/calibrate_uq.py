@@ -24,10 +24,12 @@ from typing import Any
 import numpy as np
 
 from .._versions import versions
+from ..actuator import resolve_params
 from ..calibration import Calibration
 from ..errors import InputError
 from ..faults import random_faults
 from ..models import MonitorEma, check_seed
+from ..params import EmaParams
 from .uncertainty import FIT_COVERAGE, Factors, fit_factors
 
 __all__ = ["UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"]
@@ -48,6 +50,7 @@ def collect_cases(
     absent: float = UQ_ABSENT,
     first: int = 0,
     progress: Progress | None = None,
+    params: EmaParams | None = None,
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
@@ -60,7 +63,7 @@ def collect_cases(
     for i, k in enumerate(K, start=first):
         r = identify(
             true_faults=k, seed=1000 * seed + i, calibration=calibration, monitor=monitor,
-            uncertainty="laplace", uq_calibration=Factors.identity(),
+            uncertainty="laplace", uq_calibration=Factors.identity(), params=params,
         )  # fmt: skip
         if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
             raise InputError(
@@ -80,14 +83,21 @@ def calibrate_uq(
     calibration: Calibration | str | os.PathLike[str] | None = None,
     monitor: str | None = None,
     progress: Progress | None = None,
+    params: EmaParams | str | os.PathLike[str] | None = None,
 ) -> Factors:
-    """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores)."""
+    """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
+
+    `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
+    """
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
         raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
-    lf = MonitorEma(calibration=calibration, monitor=monitor).calibration
+    actuator = resolve_params(params)
+    lf = MonitorEma(actuator, calibration=calibration, monitor=monitor).calibration
     start = time.perf_counter()
-    data = collect_cases(cases, seed, calibration=calibration, monitor=monitor, progress=progress)
+    data = collect_cases(
+        cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator
+    )
     fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"])
     record = {
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),

@@ -21,12 +21,14 @@ from numpy.typing import ArrayLike, NDArray
 from .._threads import numba_threads
 from .._version import __version__
 from .._versions import versions
-from ..calibration import Calibration
+from ..actuator import resolve_params
+from ..calibration import Calibration, params_hash
 from ..commands import Chirp, Command, SampledCommand
 from ..errors import InputError, SimulationError
 from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
 from ..models import HighFidelityEma, MonitorEma, check_seed
+from ..params import EmaParams
 from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect, load_thresholds
@@ -387,6 +389,7 @@ def identify(
     monitor: str | None = None,
     uncertainty: str = "laplace",
     uq_calibration: Factors | str | os.PathLike[str] | None = None,
+    params: EmaParams | str | os.PathLike[str] | None = None,
 ) -> IdentificationResult:
     """Identify the faults from `reference` (a trace file or `SimResult`), or from the HF twin run
     with `true_faults` and noise on (DESIGN §8). Exactly one of the two must be given.
@@ -403,8 +406,13 @@ def identify(
     or "none". With intervals a fault is detected only when its interval excludes healthy by more
     than its threshold (`uncertainty.verdicts`). `uq_calibration` is the interval calibration
     (`Factors` or a file from ``emaphm calibrate-uq``; the packaged one by default).
+
+    `params` is the actuator (`EmaParams` or the path of an actuator file, `emaphm.actuator`;
+    the paper's nominal one by default): the twin runs with it and the calibration must have
+    been made for it (``emaphm calibrate --params``).
     """
     seed = check_seed(seed)
+    actuator = resolve_params(params)
     check_optimizer(optimizer)  # before the twin runs
     if uncertainty not in UQ_METHODS:
         raise InputError(f"unknown uncertainty method {uncertainty!r}; use one of {', '.join(UQ_METHODS)}")
@@ -419,7 +427,9 @@ def identify(
         if isinstance(uq_calibration, Factors)
         else load_factors(uq_calibration)
     )
-    monitor_model = MonitorEma(calibration=calibration, monitor=monitor)  # one that does not fit: now
+    monitor_model = MonitorEma(
+        actuator, calibration=calibration, monitor=monitor
+    )  # one that does not fit: now
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -429,7 +439,7 @@ def identify(
     if true_faults is not None:
         truth = as_fault_vector(true_faults, name="true faults")
         command, source = Chirp(), "HF twin, noise on"
-        trace = HighFidelityEma(command=command).simulate(truth, noise=True, seed=noise_seed)
+        trace = HighFidelityEma(actuator, command).simulate(truth, noise=True, seed=noise_seed)
     else:
         trace = reference if isinstance(reference, SimResult) else read_trace(Path(reference))  # type: ignore[arg-type]
         for name in ("t", "theta_cmd", "i_q"):
@@ -535,6 +545,14 @@ def identify(
             "created": monitor_model.calibration.record.get("created"),
             "params_hash": monitor_model.calibration.params_hash,
             "monitor": monitor_model.monitor,
+        },
+        "params": {
+            "source": "nominal"
+            if params is None
+            else str(params)
+            if not isinstance(params, EmaParams)
+            else "EmaParams object",
+            "params_hash": params_hash(actuator),
         },
         "uncertainty": uncertainty,
         "uq_calibration": None

@@ -1,0 +1,213 @@
+"""The actuator file: every parameter of the EMA (DESIGN §7) in a TOML file (issue 10).
+
+``emaphm params --template > actuator.toml`` writes one table per block of the diagram
+(``[motor]``, ``[inverter]``, ``[transmission]``, ``[controller]``, ``[sensors]``,
+``[integration]``), each parameter keyed by its name in `emaphm.params` (``R_s = 0.5``) with its
+unit and meaning as a comment. ``--params FILE`` (``params=`` in the API) reads it back:
+
+- a value is a number in the SI unit of the comment, or a string with a unit from a closed
+  table: ``L_s = "1.5 mH"``, ``theta_max = "28.6 deg"``, ``I_max = "10000 mA"``;
+- a parameter left out keeps the paper's nominal value; a key may also stand at the top level
+  (``R_s = 0.6``) and is then found in its block;
+- unknown tables or keys, a unit of another kind (``R_s = "1 mH"``), a value that fails its
+  check (``eta = 1.2``) or that lies outside the range emaphm accepts (`ACCEPTED`, wide enough
+  for any EMA, narrow enough to catch a unit slip such as ``L_s = 1.5`` for 1.5 mH) raise
+  `InputError` naming the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError
+from .params import EmaParams
+
+__all__ = ["ACCEPTED", "UNITS", "load_params", "params_from_dict", "params_template", "resolve_params"]
+
+_DEG = math.pi / 180.0
+
+# every unit a value may carry, by the SI unit of its parameter (the field metadata's): factor to SI
+UNITS: dict[str, dict[str, float]] = {
+    "-": {"-": 1.0, "%": 0.01},
+    "Ω": {"Ω": 1.0, "ohm": 1.0, "mΩ": 1e-3, "mohm": 1e-3},
+    "H": {"H": 1.0, "mH": 1e-3, "µH": 1e-6, "uH": 1e-6},
+    "Wb": {"Wb": 1.0, "mWb": 1e-3, "V·s": 1.0},
+    "V": {"V": 1.0, "kV": 1e3},
+    "A": {"A": 1.0, "mA": 1e-3},
+    "kg·m²": {"kg·m²": 1.0, "kg·cm²": 1e-4, "g·cm²": 1e-7},
+    "N·m·s/rad": {"N·m·s/rad": 1.0, "mN·m·s/rad": 1e-3},
+    "N·m": {"N·m": 1.0, "Nm": 1.0, "mN·m": 1e-3, "mNm": 1e-3},
+    "rad": {"rad": 1.0, "mrad": 1e-3, "deg": _DEG, "°": _DEG, "arcmin": _DEG / 60.0},
+    "A/rad": {"A/rad": 1.0, "A/deg": 1.0 / _DEG},
+    "A/(rad·s)": {"A/(rad·s)": 1.0, "A/(deg·s)": 1.0 / _DEG},
+    "A·s/rad": {"A·s/rad": 1.0, "A·s/deg": 1.0 / _DEG},
+    "s": {"s": 1.0, "ms": 1e-3, "µs": 1e-6, "us": 1e-6, "ns": 1e-9},
+    "Hz": {"Hz": 1.0, "kHz": 1e3},
+    "bit": {"bit": 1.0, "bits": 1.0},
+}
+
+# the range emaphm accepts per parameter (SI): every EMA of flight controls fits, and a value given
+# in the wrong unit (mH as H, deg as rad, mA as A) falls out of it
+ACCEPTED: dict[str, tuple[float, float]] = {
+    "p": (1, 50), "R_s": (1e-3, 100.0), "L_s": (1e-6, 0.5), "psi_m": (1e-4, 2.0),
+    "V_dc": (5.0, 1000.0), "h": (1e-3, 10.0),
+    "J_m": (1e-8, 1.0), "J_u": (1e-6, 1e4), "tau": (1.0, 1e4), "eta": (0.05, 1.0), "C": (0.0, 1.0),
+    "F_S0": (0.0, 100.0), "F_D0": (0.0, 100.0), "B0": (0.0, 0.05), "theta_max": (0.01, 3.2),
+    "T_load": (0.0, 1e5),
+    "K_P0": (0.01, 1e5), "K_I": (0.0, 1e7), "K_D": (0.0, 1e4), "tau_D": (1e-6, 1.0),
+    "I_max": (0.01, 1000.0), "f_s": (500.0, 1e6),
+    "bits_current": (0, 32), "full_scale_current": (0.01, 1e4), "sigma_current": (0.0, 100.0),
+    "bits_position": (0, 32), "full_scale_position": (0.01, 10.0), "sigma_position": (0.0, 0.1),
+    "dt": (1e-8, 1e-3), "ripple_fraction": (0.01, 1.0),
+}  # fmt: skip
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+
+
+def _groups() -> dict[str, type]:
+    """Block name → parameter dataclass, in the order of `EmaParams`."""
+    return {f.name: type(getattr(EmaParams(), f.name)) for f in dataclasses.fields(EmaParams)}
+
+
+def _fields() -> dict[str, tuple[str, dataclasses.Field[Any]]]:
+    """Parameter name → (block, field): the names are unique across blocks."""
+    return {f.name: (group, f) for group, cls in _groups().items() for f in dataclasses.fields(cls)}
+
+
+def _normalise_unit(unit: str) -> str:
+    u = unit.strip().replace("μ", "µ").replace("*", "·").replace("^2", "²")
+    return re.sub(r"(?<=\w) (?=\w)", "·", u)  # "kg m²" -> "kg·m²"
+
+
+def _value(raw: Any, key: str, si_unit: str, where: str) -> float | int:
+    """The SI value of one entry: a number as it is, or a string "<number> <unit>"."""
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise InputError(f"{where}: {key} must be a number or a string with a unit, got {raw!r}")
+    if not isinstance(raw, str):
+        return raw
+    match = _QUANTITY.match(raw)
+    if match is None:
+        raise InputError(f'{where}: {key} = {raw!r} is not a number with a unit (e.g. "1.5 {si_unit}")')
+    number, unit = float(match.group(1)), _normalise_unit(match.group(2))
+    table = UNITS[si_unit]
+    if unit == "":
+        return number
+    if unit not in table:
+        raise InputError(
+            f"{where}: {key} = {raw!r}: unit {match.group(2)!r} is not one for {key} "
+            f"(its unit is {si_unit}; accepted: {', '.join(table)})"
+        )
+    value = number * table[unit]
+    return round(value) if float(value).is_integer() and si_unit == "bit" else value
+
+
+def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaParams:
+    """`EmaParams` from the parsed TOML of an actuator file (see the module docstring)."""
+    groups, fields = _groups(), _fields()
+    values: dict[str, dict[str, Any]] = {g: {} for g in groups}
+    seen: dict[str, str] = {}
+
+    def take(key: str, raw: Any, block: str | None) -> None:
+        if key not in fields:
+            inside = f"[{block}] " if block else ""
+            raise InputError(f"{where}: unknown parameter {inside}{key!r}; see 'emaphm params --template'")
+        group, f = fields[key]
+        if block is not None and block != group:
+            raise InputError(f"{where}: {key} belongs in [{group}], not in [{block}]")
+        if key in seen:
+            raise InputError(f"{where}: {key} is given twice ({seen[key]} and {block or 'top level'})")
+        seen[key] = block or "top level"
+        si_unit = f.metadata["unit"]
+        value = _value(raw, key, si_unit, where)
+        lo, hi = ACCEPTED[key]
+        if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            raise InputError(f"{where}: {key} must be a finite number, got {raw!r}")
+        if not lo <= value <= hi:
+            hint = (
+                f': is it in another unit? write the unit, e.g. {key} = "{raw} {_example_unit(si_unit)}"'
+                if si_unit not in ("-", "bit")
+                else ""
+            )
+            raise InputError(
+                f"{where}: {key} = {raw!r} is outside the range emaphm accepts, {lo:g} to {hi:g} {si_unit}{hint}"
+            )
+        values[group][key] = value
+
+    for key, raw in data.items():
+        if isinstance(raw, dict):
+            if key not in groups:
+                raise InputError(f"{where}: unknown table [{key}]; the tables are {', '.join(groups)}")
+            for name, item in raw.items():
+                take(name, item, key)
+        else:
+            take(key, raw, None)
+    try:
+        return EmaParams(**{g: groups[g](**v) for g, v in values.items()})
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _example_unit(si_unit: str) -> str:
+    others = [u for u in UNITS[si_unit] if u != si_unit]
+    return others[0] if others else si_unit
+
+
+def load_params(path: str | os.PathLike[str]) -> EmaParams:
+    """Read an actuator file (TOML); `InputError` for a missing, malformed or invalid file."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{p}: no such actuator file")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: cannot read the actuator file ({exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{p}: not a valid TOML file ({exc})") from None
+    return params_from_dict(data, str(p))
+
+
+def resolve_params(params: EmaParams | str | os.PathLike[str] | None) -> EmaParams:
+    """`EmaParams` from parameters, the path of an actuator file, or None (the nominal actuator)."""
+    if params is None:
+        return EmaParams()
+    if isinstance(params, EmaParams):
+        return params
+    if isinstance(params, (str, os.PathLike)):
+        return load_params(params)
+    raise InputError(f"params must be EmaParams or the path of an actuator file, got {type(params).__name__}")
+
+
+def _toml_number(value: float | int) -> str:
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    text = repr(float(value))
+    return text if any(c in text for c in ".en") else text + ".0"
+
+
+def params_template(params: EmaParams | None = None) -> str:
+    """A complete actuator file (TOML) with the values of `params` (default: nominal), every key
+    with its unit and meaning as a comment."""
+    params = params if params is not None else EmaParams()
+    lines = [
+        "# emaphm actuator file: every parameter of the EMA (DESIGN §7), one table per block.",
+        "# A value is a number in the unit of its comment, or a string with a unit:",
+        '#   L_s = "1.5 mH", theta_max = "28.6 deg", I_max = "10000 mA".',
+        "# A parameter left out keeps the nominal value of the paper's actuator.",
+        "# Check a file with: emaphm params FILE",
+    ]
+    for group, cls in _groups().items():
+        lines += ["", f"[{group}]  # {(cls.__doc__ or '').strip().splitlines()[0]}"]
+        instance = getattr(params, group)
+        entries = [
+            (f.name, _toml_number(getattr(instance, f.name)), f.metadata) for f in dataclasses.fields(cls)
+        ]
+        width = max(len(n) + len(v) + 3 for n, v, _ in entries)
+        for name, value, meta in entries:
+            lines.append(f"{name} = {value}".ljust(width) + f"  # [{meta['unit']}] {meta['doc']}")
+    return "\n".join(lines) + "\n"

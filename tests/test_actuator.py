@@ -1,0 +1,175 @@
+"""The actuator file (issue 10): template, units, refusals, and a calibration bound to its actuator."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+import tomllib
+
+import pytest
+
+from emaphm import EmaParams, InputError
+from emaphm.actuator import ACCEPTED, UNITS, load_params, params_from_dict, params_template
+from emaphm.calibration import COEFFICIENT_BOUNDS, Coefficients, coefficient_bounds, params_hash
+from emaphm.commands import Sine
+from emaphm.identification.calibrate import Scenario, calibrate
+from emaphm.models import MonitorEma
+from emaphm.params import _GROUPS
+from tests.helpers import run_cli
+
+OTHER = EmaParams(
+    motor=dataclasses.replace(EmaParams().motor, R_s=0.6),
+    transmission=dataclasses.replace(EmaParams().transmission, J_u=0.035),
+)
+
+
+def test_the_template_names_every_parameter_with_its_unit_and_reads_back_to_the_nominal_actuator():
+    text = params_template()
+    for group in _GROUPS:
+        for f in dataclasses.fields(group):
+            # one line per parameter: "name = value  # [unit] meaning"
+            (line,) = [ln for ln in text.splitlines() if re.match(rf"^{f.name} = ", ln)]
+            assert f"# [{f.metadata['unit']}] {f.metadata['doc']}" in line, f.name
+            assert f.name in ACCEPTED and f.metadata["unit"] in UNITS, f.name
+    assert params_from_dict(tomllib.loads(text)) == EmaParams()
+
+
+def test_a_template_of_other_parameters_reads_back_to_them(tmp_path):
+    (tmp_path / "a.toml").write_text(params_template(OTHER))
+    assert load_params(tmp_path / "a.toml") == OTHER
+    assert params_hash(OTHER) != params_hash(EmaParams())
+
+
+@pytest.mark.parametrize(
+    ("entry", "group", "name", "value"),
+    [
+        ('L_s = "1.5 mH"', "motor", "L_s", 1.5e-3),
+        ('theta_max = "28.64788975654116 deg"', "transmission", "theta_max", 0.5),
+        ('I_max = "12000 mA"', "controller", "I_max", 12.0),
+        ('tau_D = "500 us"', "controller", "tau_D", 5e-4),
+        ('J_m = "500 g cm^2"', "transmission", "J_m", 5e-5),
+        ('f_s = "20 kHz"', "controller", "f_s", 2e4),
+        ("[motor]\nR_s = 0.7", "motor", "R_s", 0.7),  # in its table
+        ("R_s = 0.7", "motor", "R_s", 0.7),  # at the top level
+    ],
+)
+def test_values_with_units_are_converted_to_si(entry, group, name, value):
+    params = params_from_dict(tomllib.loads(entry))
+    assert getattr(getattr(params, group), name) == pytest.approx(value, rel=1e-12)
+    # everything else stays nominal
+    others = {(g, k): v for g, d in params.to_dict().items() for k, v in d.items() if k != name}
+    nominal = {(g, k): v for g, d in EmaParams().to_dict().items() for k, v in d.items() if k != name}
+    assert others == nominal
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("[motor]\nR = 0.5", r"unknown parameter \[motor\] 'R'"),
+        ("[motr]\nR_s = 0.5", r"unknown table \[motr\]"),
+        ("[inverter]\nR_s = 0.5", r"R_s belongs in \[motor\]"),
+        ("R_s = 0.5\n[motor]\nR_s = 0.6", "R_s is given twice"),
+        ('R_s = "1 mH"', "unit 'mH' is not one for R_s"),
+        ('R_s = "1 furlong"', "unit 'furlong' is not one for R_s"),
+        ('R_s = "fast"', "R_s = 'fast' is not a number"),
+        ("L_s = 1.5", r"L_s = 1.5 is outside the range .* is it in another unit"),  # 1.5 mH as H
+        ("theta_max = 28.6", "theta_max = 28.6 is outside"),  # degrees as rad
+        ("eta = 1.2", "eta = 1.2 is outside"),
+        ("R_s = true", "R_s must be a number"),
+        ("R_s = nan", "R_s must be a finite number"),
+        ("p = 4.5", "whole number of pole pairs"),
+        ("F_D0 = 0.05", "F_D0=0.05 exceeds static"),
+        ("dt = 3e-6", "whole number of steps dt"),
+    ],
+)
+def test_a_bad_actuator_file_is_refused_naming_the_key(tmp_path, text, match):
+    (tmp_path / "a.toml").write_text(text + "\n")
+    with pytest.raises(InputError, match=match) as exc:
+        load_params(tmp_path / "a.toml")
+    assert str(tmp_path / "a.toml") in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_unreadable_actuator_files(tmp_path):
+    with pytest.raises(InputError, match="no such actuator file"):
+        load_params(tmp_path / "none.toml")
+    (tmp_path / "a.toml").write_text("R_s = = 1\n")
+    with pytest.raises(InputError, match="not a valid TOML file"):
+        load_params(tmp_path / "a.toml")
+
+
+def test_the_calibration_box_scales_with_the_nameplate():
+    assert coefficient_bounds() == COEFFICIENT_BOUNDS  # the nominal actuator: the shipped box, exactly
+    assert Coefficients.first_guess(EmaParams()) == Coefficients()
+    strong = EmaParams(motor=dataclasses.replace(EmaParams().motor, psi_m=0.05))  # twice the flux
+    box = coefficient_bounds(strong)
+    assert box["k_t_eq"] == pytest.approx((0.2, 0.4)) and box["k_e_eq"] == pytest.approx((0.1, 0.4))
+    assert box["k_FS"] == COEFFICIENT_BOUNDS["k_FS"] and box["J_eq"] == COEFFICIENT_BOUNDS["J_eq"]
+    guess = Coefficients.first_guess(strong)
+    assert guess.k_t_eq == pytest.approx(0.3) and box["k_t_eq"][0] < guess.k_t_eq < box["k_t_eq"][1]
+    with pytest.raises(InputError, match="k_t_eq"):
+        guess.check_bounds(EmaParams())  # 0.3 N·m/A is out of the nominal actuator's box
+    guess.check_bounds(strong)
+
+
+def test_a_calibration_is_bound_to_the_actuator_it_was_made_for(tmp_path):
+    rig = {"rig": Sine(amplitude=0.01, frequency=3.0, duration=0.3)}
+    fit = [Scenario("healthy on the rig", (0, 0, 0, 0, 0, 0, 0, 0.5), "rig")]
+    cal = calibrate(seed=2, pop_size=4, generations=1, fit=fit, check=fit, commands=rig, params=OTHER)
+    assert cal.params_hash == params_hash(OTHER)
+    assert cal.record["settings"]["bounds"]["J_eq"] == pytest.approx(
+        [b * OTHER.transmission.J / EmaParams().transmission.J for b in COEFFICIENT_BOUNDS["J_eq"]]
+    )
+    MonitorEma(OTHER, calibration=cal)  # its own actuator: accepted
+    with pytest.raises(InputError, match=rf"hash {cal.params_hash}, these are {params_hash(EmaParams())}"):
+        MonitorEma(EmaParams(), calibration=cal)
+    cal.save(tmp_path / "cal.json")
+    assert json.loads((tmp_path / "cal.json").read_text())["params_hash"] == params_hash(OTHER)
+
+
+def test_cli_params_template_check_and_refusals(tmp_path, capsys):
+    status, out, _ = run_cli(["params", "--template"], capsys)
+    assert status == 0 and params_from_dict(tomllib.loads(out)) == EmaParams()
+    (tmp_path / "a.toml").write_text(params_template(OTHER))
+    status, out, _ = run_cli(["params", str(tmp_path / "a.toml"), "--json"], capsys)
+    data = json.loads(out)
+    assert status == 0 and data["params_hash"] == params_hash(OTHER)
+    assert data["params"]["motor"]["R_s"] == 0.6
+    status, out, _ = run_cli(["params", str(tmp_path / "a.toml")], capsys)
+    assert status == 0 and params_hash(OTHER) in out and "J_u" in out
+    # the packaged calibration is the nominal actuator's: refused, naming both hashes
+    status, out, err = run_cli(
+        ["identify", "--true-faults", "0.1,0,0,0,0,0,0,0.5", "--params", str(tmp_path / "a.toml")], capsys
+    )
+    assert status == 2 and out == ""
+    assert (
+        params_hash(OTHER) in err and params_hash(EmaParams()) in err and "emaphm calibrate --params" in err
+    )
+    (tmp_path / "bad.toml").write_text('[motor]\nR_s = "2 mH"\n')
+    out_file = tmp_path / "x.h5"
+    status, _, err = run_cli(
+        ["simulate", "-o", str(out_file), "--params", str(tmp_path / "bad.toml")], capsys
+    )
+    assert status == 2 and "R_s" in err and err.count("\n") == 1 and not out_file.exists()
+
+
+def test_the_twin_runs_with_the_actuator_file(tmp_path, capsys):
+    (tmp_path / "a.toml").write_text("[transmission]\nJ_u = 0.035\n")
+    status, _, _ = run_cli(
+        [
+            "simulate",
+            "-o",
+            str(tmp_path / "x.h5"),
+            "--params",
+            str(tmp_path / "a.toml"),
+            "--duration",
+            "0.05",
+        ],
+        capsys,
+    )
+    assert status == 0
+    from emaphm.io import read_trace
+
+    recorded = read_trace(tmp_path / "x.h5").metadata["params"]
+    assert recorded["transmission"]["J_u"] == 0.035 and math.isclose(recorded["motor"]["R_s"], 0.5)
