@@ -3,6 +3,7 @@
     python benchmarks/bench_multifault.py [--cases 40] [--seeds 2] [--restarts 3] [--case-seed 2611]
                                           [--monitor default|paper] [--command chirp|chirp-2s|chirp-hold|steps]
                                           [--starts 2 --pop-size 64 --generations 30]
+                                          [--params ACTUATOR.toml --calibration CAL.json]
 
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) drawn from --case-seed, a seed of this
 script's own (the calibration and `bench_identify.py` use others). Each case is identified with
@@ -13,6 +14,8 @@ the twin under another of the calibration's commands (the trace is then identifi
 the default one). --starts N runs N independent identifications per measurement (optimiser seeds
 s, 5000 + s, ...; each with --pop-size x --generations and its polish) and keeps the best: a
 candidate search scheme against wrong basins (BENCHMARKS.md), not what `emaphm identify` does.
+--params and --calibration run another actuator (an actuator file, issue 10) on its own twin with
+its own calibration (``emaphm calibrate --params``).
 
 Printed per case and in summary:
 - LF-vs-HF NRMSE at the truth (noise off, 150 Hz filtered): the monitor's bias for that actuator;
@@ -36,6 +39,8 @@ import numpy as np
 from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
+from emaphm.actuator import resolve_params
+from emaphm.calibration import params_hash
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
@@ -74,16 +79,20 @@ def main() -> None:
     )
     parser.add_argument("--pop-size", type=int, default=None, help="population of each search")
     parser.add_argument("--generations", type=int, default=None, help="generations of each search")
+    parser.add_argument("--params", default=None, help="actuator file (default: the nominal actuator)")
+    parser.add_argument("--calibration", default=None, help="its LF calibration (default: the packaged one)")
     args = parser.parse_args()
+    params = resolve_params(args.params)
     cpu = cpu_model()
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
           f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
           f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}, "
-          f"{args.starts} start(s) of pop {args.pop_size or 'default'} x {args.generations or 'default'}")  # fmt: skip
+          f"{args.starts} start(s) of pop {args.pop_size or 'default'} x {args.generations or 'default'}; "
+          f"actuator {args.params or 'nominal'} ({params_hash(params)}), calibration {args.calibration or 'packaged'}")  # fmt: skip
     cases = random_faults(args.cases, args.case_seed)
     command = CALIBRATION_COMMANDS[args.command]
-    monitor = MonitorEma(command=command, monitor=args.monitor)
-    hf = HighFidelityEma(command=command)
+    monitor = MonitorEma(params, command, args.calibration, monitor=args.monitor)
+    hf = HighFidelityEma(params, command)
     errs, walls, wrong, bias_runs, nrmses = [], [], 0, 0, []
     print(
         f"{'case':>4} {'NRMSE':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'wall':>5}  shorts"
@@ -99,7 +108,8 @@ def main() -> None:
             starts = [
                 emaphm.identify(
                     reference=trace, seed=s + 5000 * q, optimizer=args.optimizer, monitor=args.monitor,
-                    pop_size=args.pop_size, generations=args.generations,
+                    pop_size=args.pop_size, generations=args.generations, params=params,
+                    calibration=monitor.calibration,
                 )
                 for q in range(args.starts)
             ]  # fmt: skip
@@ -109,7 +119,12 @@ def main() -> None:
             errs.append(err)
             others = [
                 emaphm.identify(
-                    reference=trace, seed=1000 * r + s, optimizer=args.optimizer, monitor=args.monitor
+                    reference=trace,
+                    seed=1000 * r + s,
+                    optimizer=args.optimizer,
+                    monitor=args.monitor,
+                    params=params,
+                    calibration=monitor.calibration,
                 ).fitness
                 for r in range(1, args.restarts + 1)
             ]

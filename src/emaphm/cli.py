@@ -152,6 +152,10 @@ def identify(
     params: Annotated[
         Path | None, typer.Option("--params", help=PARAMS_HELP + " Needs its --calibration.")
     ] = None,
+    report: Annotated[
+        Path | None,
+        typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
+    ] = None,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current."""
     import json
@@ -175,6 +179,10 @@ def identify(
         check_output_path(
             output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params)
         )
+    if report is not None:
+        from .report import check_report_dir
+
+        check_report_dir(report)
     if uncertainty == "none" and uq_calibration is not None:
         raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
     if uncertainty != "none":
@@ -196,6 +204,18 @@ def identify(
     if output is not None:
         with atomic_path(output) as tmp:
             tmp.write_text(json.dumps(data, indent=2) + "\n")
+    if report is not None:
+        from .report import sha256_of, write_report
+
+        provenance: dict[str, Any] = {
+            "reference": str(reference) if reference is not None else "HF twin, noise on",
+            "sha256": sha256_of(reference) if reference is not None else None,
+            "true_faults": None if truth is None else truth.tolist(),
+            "params": str(params) if params is not None else "nominal",
+            "calibration": str(calibration) if calibration is not None else "packaged",
+        }
+        page = write_report(result, report, provenance=provenance)
+        err.print(f"wrote the report {page}")
     if json_out:
         typer.echo(json.dumps(data))
     else:

@@ -92,6 +92,32 @@ def plot_fit(
     return path
 
 
+def plot_fit_curves(curves: Mapping[str, np.ndarray], path: Path, title: str = "") -> Path:
+    """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the LF
+    current at the estimate and their residual; samples the fitness left out (a hold) shaded."""
+    plt = _pyplot()
+    t, m, f = curves["t"], curves["measured"], curves["fitted"]
+    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
+    ax[0].plot(t, m, "k", lw=1.0, label="measured $i_q$, filtered")
+    ax[0].plot(t, f, "C1", lw=1.0, label="LF model at the identified faults")
+    ax[0].set_ylabel("current [A]")
+    ax[0].legend(loc="upper right", fontsize=8)
+    ax[1].plot(t, m - f, "C3", lw=0.8)
+    ax[1].set_ylabel("residual [A]")
+    ax[1].set_xlabel("time [s]")
+    left_out = np.asarray(curves.get("compared", np.ones_like(t))) <= 0
+    for a in ax:
+        a.grid(alpha=0.3)
+        if left_out.any():
+            a.fill_between(t, 0, 1, where=left_out, color="0.9", transform=a.get_xaxis_transform(),
+                           label="not compared (hold)")  # fmt: skip
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
     """Best fitness per generation of each run (log scale)."""
     plt = _pyplot()
@@ -108,14 +134,14 @@ def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
 
 
 def plot_vectors(
-    truth: np.ndarray,
+    truth: np.ndarray | None,
     estimates: Mapping[str, np.ndarray],
     names: tuple[str, ...],
     path: Path,
     intervals: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
     phase_undefined: Collection[str] = (),
 ) -> Path:
-    """Identified vs true fault vector, one group of bars per fault.
+    """Identified vs true fault vector (None: unknown, not drawn), one group of bars per fault.
 
     `intervals` (label → (ci90_low, ci90_high)) draws each estimate's 90 % interval as an error
     bar (k7 only when its arc does not wrap through 0). The k7 bar of each label in
@@ -123,11 +149,13 @@ def plot_vectors(
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 4), layout="constrained")
-    n = len(estimates) + 1
+    first = 0 if truth is None else 1
+    n = len(estimates) + first
     width = 0.8 / n
-    x = np.arange(len(truth))
-    ax.bar(x - 0.4 + width / 2, truth, width, color="k", label="true")
-    for j, (label, k) in enumerate(estimates.items(), start=1):
+    x = np.arange(len(names))
+    if truth is not None:
+        ax.bar(x - 0.4 + width / 2, truth, width, color="k", label="true")
+    for j, (label, k) in enumerate(estimates.items(), start=first):
         pos = x - 0.4 + width / 2 + j * width
         bars = ax.bar(pos, k, width, label=label)
         undefined = label in phase_undefined

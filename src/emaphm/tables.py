@@ -6,18 +6,18 @@ from typing import Any
 
 from rich.table import Table
 
-__all__ = ["fault_table"]
+__all__ = ["fault_rows", "fault_table"]
 
 
-def fault_table(data: dict[str, Any], title: str) -> Table:
-    """One row per fault of an identification's JSON (`IdentificationResult.to_json`): its value,
-    the ± half-width, interval and flags of its 90 % interval when there is one, the true value
-    when known, and its verdict (present / absent / cannot tell; "-" when the monitor does not
-    explain the recording)."""
+def fault_rows(data: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
+    """The column names and the text rows of the per-fault table of an identification's JSON
+    (`IdentificationResult.to_json`): one row per fault with its value, the ± half-width,
+    interval and flags of its 90 % interval when there is one, the true value when known, and
+    its verdict (present / absent / cannot tell; "-" when the monitor does not explain the
+    recording)."""
     from .identification.uncertainty import half_widths
 
     intervals = data["ci90_low"] is not None
-    table = Table(title=title)
     columns = ["fault", "identified"]
     if intervals:
         columns += ["± half-width", "90 % interval", "flags"]
@@ -25,9 +25,8 @@ def fault_table(data: dict[str, Any], title: str) -> Table:
     if data["truth"] is not None:
         columns.append("true")
     columns.append("verdict")
-    for name in columns:
-        table.add_column(name, justify="left" if name in ("fault", "flags", "verdict") else "right")
     verdicts = data.get("fault_verdicts") or {}
+    rows = []
     for i, name in enumerate(data["fault_names"]):
         row = [f"k{i + 1} {name}", f"{data['estimate'][i]:.4f}"]
         if intervals:
@@ -46,5 +45,16 @@ def fault_table(data: dict[str, Any], title: str) -> Table:
             row.append(verdicts.get(name, "(direction)"))
         else:
             row.append("present" if name in data["detected"] else "-")
+        rows.append(row)
+    return columns, rows
+
+
+def fault_table(data: dict[str, Any], title: str) -> Table:
+    """The per-fault table (`fault_rows`) as a rich table."""
+    columns, rows = fault_rows(data)
+    table = Table(title=title)
+    for name in columns:
+        table.add_column(name, justify="left" if name in ("fault", "flags", "verdict") else "right")
+    for row in rows:
         table.add_row(*row)
     return table

@@ -100,6 +100,8 @@ class IdentificationResult:
     uncertainty: Uncertainty | None = None
     # per detectable fault: "present", "absent" or "cannot tell" (`uncertainty.verdicts`)
     fault_verdicts: dict[str, str] | None = None
+    # the fit on the model grid (`FaultIdentifier.curves`), for figures and reports; not in the JSON
+    curves: dict[str, NDArray[np.float64]] | None = field(default=None, repr=False, compare=False)
 
     @property
     def fits(self) -> bool:
@@ -296,13 +298,23 @@ class FaultIdentifier:
         self.fitness_ = run.f
         self.run_ = run
         # how well the best LF current explains the compared samples (both filtered), for the verdict
+        self.fitted_: NDArray[np.float64] | None = None
         try:
             best = self.reference_.filtered(monitor.simulate(self.faults_, duration=duration).i_q)
             keep = self.mask_ > 0
             self.fit_nrmse_ = float(nrmse(self.reference_.reference[keep], best[keep]))
+            self.fitted_ = best
         except SimulationError:
             self.fit_nrmse_ = float("inf")
         return self
+
+    def curves(self) -> dict[str, NDArray[np.float64]]:
+        """The fit as curves on the model grid: ``t`` [s], the filtered ``measured`` current and
+        the ``fitted`` LF current at the estimate [A] (NaN if its run diverged), and ``compared``,
+        the weight each sample had in the fitness (0 in a hold left out)."""
+        fitted = self.fitted_ if self.fitted_ is not None else np.full_like(self.reference_.reference, np.nan)
+        return {"t": self.reference_.t, "measured": self.reference_.reference, "fitted": fitted,
+                "compared": self.mask_}  # fmt: skip
 
 
 # the five other assignments of the three short magnitudes (k3, k4, k5) to the phases A, B, C
@@ -572,5 +584,5 @@ def identify(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=run.evaluations,
         wall_time_s=round(time.perf_counter() - start, 3), seed=seed, optimizer=optimizer, truth=truth,
         detected=detected, history=run.history, settings=settings, warnings=warnings,
-        fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged,
+        fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged, curves=ident.curves(),
     )  # fmt: skip

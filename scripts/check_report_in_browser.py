@@ -1,0 +1,92 @@
+"""Open an emaphm report in a real headless browser and check what a person would see (issue 10).
+
+    python scripts/check_report_in_browser.py REPORT_DIR [--screenshot shot.png]
+
+Loads REPORT_DIR/index.html in headless Chromium (Debian's `chromium` package; `apt install
+chromium`), after its scripts ran, and checks that every figure decoded (the page's own count
+of images with a natural width, `data-images-loaded`), that the verdict and the per-fault table
+are in the rendered page, and that the page asked for nothing outside itself. Prints what it
+found; exit 0 when all hold, 1 otherwise, 2 when no browser is installed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+FLAGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--virtual-time-budget=5000",
+]  # fmt: skip
+
+
+def browser() -> str | None:
+    return next(
+        (shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome") if shutil.which(b)), None
+    )
+
+
+def rendered_dom(page: Path, exe: str) -> str:
+    with tempfile.TemporaryDirectory() as profile:
+        res = subprocess.run(
+            [exe, *FLAGS, f"--user-data-dir={profile}", "--dump-dom", page.resolve().as_uri()],
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+    return res.stdout
+
+
+def check(report: Path, screenshot: Path | None = None) -> list[str]:
+    """The problems found in the rendered report (empty when it is fine)."""
+    exe = browser()
+    if exe is None:
+        raise FileNotFoundError("no headless browser: apt install chromium")
+    page = report / "index.html"
+    source = page.read_text(encoding="utf-8")
+    dom = rendered_dom(page, exe)
+    problems = []
+    loaded = re.search(r'data-images-loaded="(\d+)/(\d+)"', dom)
+    if loaded is None:
+        problems.append("the page's script did not run (no data-images-loaded)")
+    elif loaded.group(1) != loaded.group(2) or loaded.group(2) == "0":
+        problems.append(f"figures decoded: {loaded.group(1)} of {loaded.group(2)}")
+    if not re.search(r'class="verdict (fits|nofit)"', dom):
+        problems.append("no verdict in the rendered page")
+    if "k1 friction" not in dom or "k8 kp_drift" not in dom:
+        problems.append("the per-fault table is not in the rendered page")
+    outside = re.findall(r'(?:src|href)="(?!data:)([^"]+)"', source)
+    if outside:
+        problems.append(f"the page refers to files or addresses outside itself: {outside[:3]}")
+    if screenshot is not None:
+        with tempfile.TemporaryDirectory() as profile:
+            subprocess.run(
+                [exe, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={screenshot}", "--window-size=1100,1800",
+                 page.resolve().as_uri()],
+                capture_output=True, timeout=120, check=False,
+            )  # fmt: skip
+    return problems
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("report", type=Path)
+    parser.add_argument("--screenshot", type=Path, default=None)
+    args = parser.parse_args()
+    try:
+        problems = check(args.report, args.screenshot)
+    except FileNotFoundError as exc:
+        print(f"check_report_in_browser: {exc}", file=sys.stderr)
+        sys.exit(2)
+    for p in problems:
+        print(f"problem: {p}")
+    print("report OK in headless Chromium" if not problems else f"{len(problems)} problem(s)")
+    sys.exit(1 if problems else 0)
+
+
+if __name__ == "__main__":
+    main()
