@@ -4,7 +4,7 @@
 
 A current recorded at --rate: a 3 Hz + 40 Hz signal (what the comparison keeps) plus 50 mA of
 hysteresis-inverter ripple whose switching frequency wanders 12-20 kHz (16 kHz ± 4 kHz at 7 Hz),
-or a fixed 16 kHz tone. It is brought onto the 10 kHz model grid two ways, then through the
+or a fixed tone at 16 kHz (two phases) or 16.1 kHz. It is brought onto the 10 kHz model grid two ways, then through the
 comparison's 150 Hz filter, and compared in that band with the signal alone:
 - interpolate-then-filter (`np.interp` onto the grid, the path before issue 10);
 - filter-then-resample (`signals.resample`: an anti-aliasing low-pass on the source grid first).
@@ -35,6 +35,8 @@ def main() -> None:
     ripples = {
         "ripple 12-20 kHz (wandering)": 0.05 * np.sin(2 * np.pi * (16e3 * t_src - 4e3 / (2 * np.pi * 7) * np.cos(2 * np.pi * 7 * t_src))),
         "ripple 16 kHz tone": 0.05 * np.sin(2 * np.pi * 16e3 * t_src),
+        "ripple 16 kHz tone, phase 1 rad": 0.05 * np.sin(2 * np.pi * 16e3 * t_src + 1.0),
+        "ripple 16.1 kHz tone": 0.05 * np.sin(2 * np.pi * 16.1e3 * t_src + 0.3),
     }  # fmt: skip
     truth = lowpass(signal(grid), F_GRID)
     for name, ripple in ripples.items():
