@@ -120,7 +120,17 @@ def identify(
         typer.Option(help="Simulate the HF twin (noise on) with these faults k1..k8 and identify them."),
     ] = None,
     reference: Annotated[
-        Path | None, typer.Option(help="Identify from a trace written by 'emaphm simulate'.")
+        Path | None,
+        typer.Option(
+            help="Identify from a trace ('emaphm simulate', 'emaphm convert'), or a recording with --map."
+        ),
+    ] = None,
+    map_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--map",
+            help="Channel map (TOML) that reads --reference as a rig's recording (docs/your-actuator.md).",
+        ),
     ] = None,
     optimizer: Annotated[str, typer.Option(help="ga, de, pso, cmaes or gwo.")] = "ga",
     seed: Annotated[int, typer.Option(help="Seed of the optimiser (and of the twin's noise).")] = 0,
@@ -173,11 +183,17 @@ def identify(
     check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     check_seed(seed)
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
-    if reference is not None:
+    if reference is not None and map_file is None:
         check_trace_path(reference, for_writing=False)
+    if map_file is not None:
+        from .measured import ChannelMap
+
+        if reference is None:
+            raise InputError("--map reads a recording: give it with --reference")
+        ChannelMap.load(map_file)  # a bad map: refused before the work
     if output is not None:
         check_output_path(
-            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params)
+            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params, map_file)
         )
     if report is not None:
         from .report import check_report_dir
@@ -193,7 +209,7 @@ def identify(
         result = run_identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
             generations=generations, local_polish=polish, calibration=calibration, monitor=monitor,
-            uncertainty=uncertainty, uq_calibration=uq_calibration, params=params,
+            uncertainty=uncertainty, uq_calibration=uq_calibration, params=params, channel_map=map_file,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
             ),
@@ -211,6 +227,8 @@ def identify(
             "reference": str(reference) if reference is not None else "HF twin, noise on",
             "sha256": sha256_of(reference) if reference is not None else None,
             "true_faults": None if truth is None else truth.tolist(),
+            "channel_map": str(map_file) if map_file is not None else None,
+            "conversion": data["settings"].get("conversion"),
             "params": str(params) if params is not None else "nominal",
             "calibration": str(calibration) if calibration is not None else "packaged",
         }
@@ -353,6 +371,122 @@ def _progress() -> Iterator[Callable[[str, int, int], None]]:
             bar.update(tasks[stage], completed=done)
 
         yield update
+
+
+@app.command()
+def convert(
+    source: Annotated[
+        Path, typer.Argument(help="A rig's recording: CSV, HDF5, MATLAB .mat (v5, v7.3) or Parquet.")
+    ],
+    map_file: Annotated[
+        Path, typer.Option("--map", help="Channel map (TOML): which column is which signal, in which unit.")
+    ],
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Reference trace to write: .h5 or .csv (+ .csv.json).")
+    ],
+    params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the conversion report as one JSON object.")
+    ] = False,
+) -> None:
+    """Convert a recording into a reference trace on the model grid (SI, i_q, with its provenance)."""
+    import json
+
+    from .actuator import resolve_params
+    from .io import TRACE_SUFFIXES, check_output_path
+    from .measured import ChannelMap, load_measurement, to_reference, write_reference
+
+    check_output_path(output, suffixes=TRACE_SUFFIXES, inputs=(source, map_file, params))
+    cmap = ChannelMap.load(map_file)
+    actuator = resolve_params(params)
+    with _status(f"converting {source}"):
+        ref = to_reference(load_measurement(source, cmap), actuator)
+    write_reference(ref, output)
+    report = ref.report
+    if json_out:
+        typer.echo(json.dumps(report, default=str))
+    for warning in report.get("warnings", []):
+        err.print(f"emaphm: warning: {warning}", soft_wrap=True)
+    angle = report.get("angle") or {}
+    if angle.get("offset_deg") is not None:
+        err.print(f"angle offset {angle['offset_deg']:.2f} deg ({angle.get('offset_method', '')})")
+    used = report["segments"]["used"]
+    err.print(
+        f"wrote {output} ({report['grid']['samples']} samples at {report['grid']['f_s']:g} Hz, "
+        f"{used[0]:g}..{used[1]:g} s of the record)"
+    )
+
+
+@app.command("inspect")
+def inspect_command(
+    source: Annotated[Path, typer.Argument(help="A recording (CSV, HDF5, MATLAB .mat, Parquet).")],
+    map_file: Annotated[
+        Path | None, typer.Option("--map", help="Channel map (TOML) to check it against.")
+    ] = None,
+    params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print what was found as one JSON object.")
+    ] = False,
+) -> None:
+    """What a recording holds (channels, rates, duration, ranges, saturation, problems); exit 0 if usable, 2 if not."""
+    import json
+
+    from .actuator import resolve_params
+    from .measured import ChannelMap, inspect_file
+
+    cmap = ChannelMap.load(map_file) if map_file is not None else None
+    info = inspect_file(source, cmap, resolve_params(params))
+    if json_out:
+        typer.echo(json.dumps(info, default=str))
+    else:
+        _print_inspection(info)
+    if not info["usable"]:
+        raise typer.Exit(2)
+
+
+def _print_inspection(info: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    out = _stdout_console()
+    out.print(f"{info['file']}: {info['format']}, {info.get('size_bytes', 0) / 1e6:.1f} MB")
+    if info.get("channels"):
+        table = Table(title="mapped channels (SI)")
+        for column in (
+            "channel",
+            "name",
+            "unit",
+            "samples",
+            "rate [Hz]",
+            "duration [s]",
+            "min",
+            "max",
+            "saturation",
+        ):
+            table.add_column(
+                column, justify="left" if column in ("channel", "name", "unit", "saturation") else "right"
+            )
+        for role, ch in info["channels"].items():
+            table.add_row(
+                role, str(ch.get("name")), str(ch.get("unit")), str(ch.get("samples")),
+                f"{ch['rate_hz']:.6g}" if ch.get("rate_hz") else "-",
+                f"{ch['duration_s']:.4g}" if ch.get("duration_s") is not None else "-",
+                f"{ch['min_si']:.4g}" if ch.get("min_si") is not None else "-",
+                f"{ch['max_si']:.4g}" if ch.get("max_si") is not None else "-",
+                str(ch.get("saturation") or ""),
+            )  # fmt: skip
+        out.print(table)
+    else:
+        table = Table(title="variables found")
+        for column in ("name", "length", "type"):
+            table.add_column(column)
+        for v in info.get("variables", []):
+            table.add_row(str(v.get("name")), str(v.get("length")), str(v.get("dtype")))
+        out.print(table)
+    for w in info.get("warnings", []):
+        out.print(f"warning: {w}")
+    for p in info.get("problems", []):
+        out.print(f"problem: {p}")
+    out.print("usable" if info["usable"] else "not usable")
 
 
 @app.command()

@@ -220,7 +220,7 @@ def read_trace(path: str | os.PathLike[str]) -> SimResult:
     """Read a trace written by `write_trace` (or any file of the same schema).
 
     Raises `InputError` for a missing or unreadable file, missing required signals
-    (t, theta_cmd, theta_u, i_q), signals of unequal length, NaN/inf values or a time axis that
+    (t, theta_cmd, i_q; theta_u is optional), signals of unequal length, NaN/inf values or a time axis that
     is not strictly increasing.
     """
     p = check_trace_path(path, for_writing=False)

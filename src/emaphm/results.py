@@ -25,7 +25,9 @@ UNITS: dict[str, str] = {
     "T_m": "N·m",
     "theta_u_true": "rad",
 }
-REQUIRED_SIGNALS = ("t", "theta_cmd", "theta_u", "i_q")
+# what a diagnosis needs; theta_u (the measured surface position) is used when present (the holds
+# where the surface rests are left out of the fitness) but a rig may not record it
+REQUIRED_SIGNALS = ("t", "theta_cmd", "i_q")
 
 
 @dataclass(frozen=True)

@@ -100,7 +100,12 @@ def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are
     t = np.arange(5001) / 1e4
     rest = emaphm.SimResult(
         t=t,
-        signals={"theta_cmd": np.zeros_like(t), "theta_u": np.zeros_like(t), "i_q": np.zeros_like(t) + 1e-3},
+        # a rest: the command at 0 and a current of sensor noise (a constant one is refused as a dead channel)
+        signals={
+            "theta_cmd": np.zeros_like(t),
+            "theta_u": np.zeros_like(t),
+            "i_q": 1e-3 + np.random.default_rng(0).normal(0.0, 0.02, t.shape),
+        },
         metadata={},
     )
     r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)

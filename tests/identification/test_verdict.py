@@ -27,25 +27,41 @@ def test_a_real_measurement_fits(measured):
 
 
 @pytest.mark.parametrize(
-    ("mistake", "change"),
+    ("mistake", "change", "match"),
     [
-        ("current in mA", lambda s: {"i_q": 1000.0 * s["i_q"]}),
-        ("current sign flipped", lambda s: {"i_q": -s["i_q"]}),
-        ("command in degrees", lambda s: {"theta_cmd": np.degrees(s["theta_cmd"])}),
+        ("current in mA", lambda s: {"i_q": 1000.0 * s["i_q"]}, "is the current in mA"),
+        ("command in degrees", lambda s: {"theta_cmd": np.degrees(s["theta_cmd"])}, "is it in degrees"),
+        ("position in degrees", lambda s: {"theta_u": np.degrees(s["theta_u"])}, "is it in degrees"),
+        ("one corrupt sample", lambda s: {"i_q": np.where(np.arange(len(s["i_q"])) == 500, 1e30, s["i_q"])},
+         "a corrupt sample"),
+        ("an all-zero current", lambda s: {"i_q": np.zeros_like(s["i_q"])}, "is constant"),
     ],
-)
-def test_a_unit_or_sign_mistake_does_not_fit_and_reports_no_fault(measured, mistake, change):
+)  # fmt: skip
+def test_a_unit_mistake_is_refused_before_the_search(measured, mistake, change, match):
+    # newcomer.md §3-4: each of these gave a confident list of faults at exit 0 before issue 10
     signals = dict(measured.signals)
     wrong = SimResult(t=measured.t, signals={**signals, **change(signals)})
+    with pytest.raises(emaphm.InputError, match=match):
+        emaphm.identify(reference=wrong, seed=1, **BUDGET)
+
+
+def test_a_sign_mistake_does_not_fit_and_reports_no_fault(measured):
+    signals = dict(measured.signals)
+    wrong = SimResult(t=measured.t, signals={**signals, "i_q": -signals["i_q"]})
     r = emaphm.identify(reference=wrong, seed=1, **BUDGET)
-    assert r.verdict == "does not fit", mistake
+    assert r.verdict == "does not fit"
     assert r.detected == [] and any("cannot explain" in w for w in r.warnings)
 
 
-def test_the_command_line_exits_3_on_does_not_fit(measured, tmp_path, capsys):
+def test_the_command_line_exits_3_on_does_not_fit_and_2_on_a_unit_mistake(measured, tmp_path, capsys):
     signals = dict(measured.signals)
-    path = tmp_path / "mA.h5"
-    emaphm.write_trace(SimResult(t=measured.t, signals={**signals, "i_q": 1000.0 * signals["i_q"]}), path)
+    emaphm.write_trace(
+        SimResult(t=measured.t, signals={**signals, "i_q": 1000.0 * signals["i_q"]}), tmp_path / "mA.h5"
+    )
+    code, out, err = run_cli(["identify", "--reference", str(tmp_path / "mA.h5")], capsys)
+    assert code == 2 and out == "" and "is the current in mA" in err and err.count("\n") == 1
+    path = tmp_path / "flipped.h5"
+    emaphm.write_trace(SimResult(t=measured.t, signals={**signals, "i_q": -signals["i_q"]}), path)
     args = ["identify", "--reference", str(path), "--pop-size", "16", "--generations", "3", "--no-polish"]
     code, out, err = run_cli([*args, "--json"], capsys)
     assert code == 3 and json.loads(out)["verdict"] == "does not fit" and json.loads(out)["detected"] == []

@@ -27,6 +27,7 @@ from ..commands import Chirp, Command, SampledCommand
 from ..errors import InputError, SimulationError
 from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
+from ..measured.checks import plausibility
 from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..params import EmaParams
 from ..results import SimResult
@@ -402,6 +403,7 @@ def identify(
     uncertainty: str = "laplace",
     uq_calibration: Factors | str | os.PathLike[str] | None = None,
     params: EmaParams | str | os.PathLike[str] | None = None,
+    channel_map: Any = None,
 ) -> IdentificationResult:
     """Identify the faults from `reference` (a trace file or `SimResult`), or from the HF twin run
     with `true_faults` and noise on (DESIGN §8). Exactly one of the two must be given.
@@ -422,6 +424,11 @@ def identify(
     `params` is the actuator (`EmaParams` or the path of an actuator file, `emaphm.actuator`;
     the paper's nominal one by default): the twin runs with it and the calibration must have
     been made for it (``emaphm calibrate --params``).
+
+    `channel_map` (a `emaphm.measured.ChannelMap` or the path of one) reads `reference` as a
+    rig's recording (CSV, HDF5, MATLAB, Parquet; phase currents and a rotor angle or i_q, any
+    units of the map's table and rates): it is converted to a reference on the model grid first
+    (`emaphm.measured.to_reference`), and the conversion's report is in ``settings["conversion"]``.
     """
     seed = check_seed(seed)
     actuator = resolve_params(params)
@@ -445,15 +452,29 @@ def identify(
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
+    if channel_map is not None and reference is None:
+        raise InputError(
+            "a channel map reads a recording: give it with a reference file, not with true faults"
+        )
     noise_seed, opt_seed = (int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(2))
     truth = None
     command: Command
+    conversion: dict[str, Any] | None = None
     if true_faults is not None:
         truth = as_fault_vector(true_faults, name="true faults")
         command, source = Chirp(), "HF twin, noise on"
         trace = HighFidelityEma(actuator, command).simulate(truth, noise=True, seed=noise_seed)
     else:
-        trace = reference if isinstance(reference, SimResult) else read_trace(Path(reference))  # type: ignore[arg-type]
+        if channel_map is not None:
+            if isinstance(reference, SimResult):
+                raise InputError("a channel map reads a recording file, not a SimResult")
+            from ..measured import ChannelMap, load_measurement, to_reference
+
+            cmap = channel_map if isinstance(channel_map, ChannelMap) else ChannelMap.load(channel_map)
+            converted = to_reference(load_measurement(Path(reference), cmap), actuator)  # type: ignore[arg-type]
+            trace, conversion = converted.trace, converted.report
+        else:
+            trace = reference if isinstance(reference, SimResult) else read_trace(Path(reference))  # type: ignore[arg-type]
         for name in ("t", "theta_cmd", "i_q"):
             if name not in trace.names:
                 raise InputError(f"the reference trace has no {name!r} signal")
@@ -464,6 +485,10 @@ def identify(
             raise InputError(
                 f"the reference spans {span:g} s; a diagnosis needs at least {MIN_SPAN:g} s of the FDI command"
             )
+        problems = plausibility(trace, actuator)
+        if problems:  # a unit or channel mistake: refused before the search rather than fitted
+            more = f" (and {len(problems) - 1} more problem(s))" if len(problems) > 1 else ""
+            raise InputError(f"the reference is not plausible for this actuator: {problems[0]}{more}")
         command = SampledCommand(trace.t - trace.t[0], trace.theta_cmd)
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
@@ -533,6 +558,8 @@ def identify(
         detected = [name for name, v in judged.items() if v == "present"]
     settings = {
         "reference": source,
+        # the recording's conversion to a reference (`channel_map`): θ0, rates, segments, flags
+        "conversion": conversion,
         "noise_seed": noise_seed if true_faults is not None else None,
         "optimizer_seed": opt_seed,
         "pop_size": pop_size,

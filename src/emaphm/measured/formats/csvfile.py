@@ -1,0 +1,198 @@
+"""CSV text: what is accepted.
+
+- optional comment lines starting with ``#`` before the header;
+- one header row of column names (quotes and surrounding spaces are stripped);
+- delimiter ``,``, ``;`` or tab, whichever the header row holds most of;
+- optionally one units row right after the header: every cell non-numeric (``A``, ``[mA]``,
+  ``(deg)``); its units are recorded and compared with the map's, never used instead of them;
+- data rows of numbers (``.`` as decimal point; ``,`` is also accepted with ``;`` or tab
+  delimiters); an empty cell or ``nan``/``NA`` is a missing value (NaN, which splits the record
+  into segments); anything else non-numeric in a mapped column is refused naming its line.
+
+Columns that are not mapped are never parsed (a text timestamp column does no harm).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...errors import InputError
+from ..limits import MAX_SAMPLES
+from .base import Column, Source
+
+__all__ = ["CsvSource"]
+
+DELIMITERS = (",", ";", "\t")
+MISSING = {"", "nan", "NaN", "NAN", "NA", "N/A", "-nan"}
+_SNIFF_LINES = 200
+
+
+def _number(cell: str) -> float | None:
+    try:
+        return float(cell)
+    except ValueError:
+        return None
+
+
+class CsvSource(Source):
+    """A CSV file with a header row (see the module docstring)."""
+
+    format = "csv"
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        try:
+            with path.open(encoding="utf-8-sig", newline="") as fh:
+                head = [line for _, line in zip(range(_SNIFF_LINES), fh, strict=False)]
+        except UnicodeDecodeError:
+            raise InputError(
+                f"{path}: unknown format: not UTF-8 text, HDF5, MATLAB .mat or Parquet"
+            ) from None
+        except OSError as exc:
+            raise InputError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+        k = 0
+        while k < len(head) and (not head[k].strip() or head[k].lstrip().startswith("#")):
+            k += 1
+        if k == len(head):
+            raise InputError(f"{path}: the file is empty (no header row)")
+        header = head[k].rstrip("\r\n")
+        self.delimiter = max(DELIMITERS, key=header.count)
+        self.columns = [
+            c.strip().strip('"').strip("'").strip()
+            for c in next(csv.reader([header], delimiter=self.delimiter))
+        ]
+        if len(set(self.columns)) != len(self.columns):
+            dup = sorted({c for c in self.columns if self.columns.count(c) > 1})
+            raise InputError(f"{path}: line {k + 1}: duplicated column name(s) {', '.join(map(repr, dup))}")
+        self.header_line = k + 1  # 1-based line numbers in messages
+        self.units: dict[str, str] = {}
+        self.first_data_line = self.header_line + 1
+        rest = [line for line in head[k + 1 :] if line.strip()]
+        if rest:
+            cells = [c.strip().strip('"') for c in next(csv.reader([rest[0]], delimiter=self.delimiter))]
+            if all(
+                c and c not in MISSING and _number(c) is None and _number(c.replace(",", ".")) is None
+                for c in cells
+            ):
+                self.units = {
+                    name: re.sub(r"^[\[(](.*)[\])]$", r"\1", c)
+                    for name, c in zip(self.columns, cells, strict=False)
+                }
+                self.first_data_line = head.index(rest[0], k + 1) + 2
+        self._cache: dict[str, Column] = {}
+
+    def listing(self) -> list[dict[str, Any]]:
+        n = self._row_count()
+        return [
+            {"name": c, "length": n, "dtype": "text" if c in self._text_columns() else "float64",
+             "numeric": c not in self._text_columns(), **({"unit": self.units[c]} if c in self.units else {})}
+            for c in self.columns
+        ]  # fmt: skip
+
+    def has(self, name: str) -> bool:
+        return name in self.columns
+
+    def read(self, names: Sequence[str]) -> dict[str, Column]:
+        todo = [n for n in dict.fromkeys(names) if n not in self._cache]
+        if todo:
+            data = self._parse([self.columns.index(n) for n in todo])
+            if data.shape[0] == 0:
+                raise InputError(f"{self.path}: the file has a header but no data rows")
+            if data.shape[0] > MAX_SAMPLES:
+                raise InputError(
+                    f"{self.path}: {data.shape[0]:.3g} rows, more than {MAX_SAMPLES:.0e}: split the record"
+                )
+            for j, name in enumerate(todo):
+                self._cache[name] = Column(
+                    values=np.ascontiguousarray(data[:, j]), unit=self.units.get(name), row=self._line
+                )
+        return {n: self._cache[n] for n in names}
+
+    # -- parsing ------------------------------------------------------------------------------
+
+    def _parse(self, usecols: list[int]) -> np.ndarray:
+        """Fast path numpy; on any complaint, the slow path finds the cell and says where."""
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "input contained no data": said by the caller
+                data = np.loadtxt(
+                    self.path, delimiter=self.delimiter, skiprows=self.first_data_line - 1, usecols=usecols,
+                    ndmin=2, comments="#", quotechar='"', encoding="utf-8-sig", dtype=np.float64,
+                )  # fmt: skip
+            if data.shape[0] == self._data_line_count():
+                return data
+        except ValueError:  # a bad cell, an empty cell, a decimal comma, a short row, not UTF-8
+            pass
+        try:
+            return self._parse_slow(usecols)
+        except UnicodeDecodeError as exc:
+            raise InputError(
+                f"{self.path}: not UTF-8 text at byte {exc.start}: save the CSV as UTF-8"
+            ) from None
+
+    def _data_lines(self):  # type: ignore[no-untyped-def]
+        with self.path.open(encoding="utf-8-sig", newline="") as fh:
+            for lineno, line in enumerate(fh, start=1):
+                if lineno < self.first_data_line or not line.strip() or line.lstrip().startswith("#"):
+                    continue
+                yield lineno, line
+
+    def _data_line_count(self) -> int:
+        return sum(1 for _ in self._data_lines())
+
+    def _parse_slow(self, usecols: list[int]) -> np.ndarray:
+        rows: list[list[float]] = []
+        decimal_comma = self.delimiter != ","
+        width = max(usecols) + 1
+        for lineno, line in self._data_lines():
+            cells = next(csv.reader([line.rstrip("\r\n")], delimiter=self.delimiter))
+            if len(cells) < width:
+                raise InputError(
+                    f"{self.path}: line {lineno} has {len(cells)} fields, the header has {len(self.columns)}"
+                )
+            row = []
+            for j in usecols:
+                cell = cells[j].strip().strip('"').strip()
+                value = math.nan if cell in MISSING else _number(cell)
+                if value is None and decimal_comma:
+                    value = _number(cell.replace(",", "."))
+                if value is None:
+                    raise InputError(
+                        f"{self.path}: line {lineno}, column {self.columns[j]!r}: {cell[:40]!r} is not a number"
+                    )
+                row.append(value)
+            rows.append(row)
+        return np.array(rows, dtype=np.float64).reshape(len(rows), len(usecols))
+
+    def _line(self, i: int) -> str:
+        """Line number (1-based, in the file) of data row i: for messages, counted only then."""
+        for k, (lineno, _) in enumerate(self._data_lines()):
+            if k == i:
+                return f"line {lineno}"
+        return f"data row {i}"
+
+    def _row_count(self) -> int:
+        if not hasattr(self, "_n_rows"):
+            self._n_rows = self._data_line_count()
+        return self._n_rows
+
+    def _text_columns(self) -> set[str]:
+        """Columns whose first data row is not a number (listing only)."""
+        if not hasattr(self, "_text"):
+            self._text: set[str] = set()
+            for _, line in self._data_lines():
+                cells = next(csv.reader([line.rstrip("\r\n")], delimiter=self.delimiter))
+                for name, cell in zip(self.columns, cells, strict=False):
+                    c = cell.strip().strip('"')
+                    if c not in MISSING and _number(c) is None and _number(c.replace(",", ".")) is None:
+                        self._text.add(name)
+                break
+        return self._text
