@@ -173,3 +173,13 @@ def test_the_twin_runs_with_the_actuator_file(tmp_path, capsys):
 
     recorded = read_trace(tmp_path / "x.h5").metadata["params"]
     assert recorded["transmission"]["J_u"] == 0.035 and math.isclose(recorded["motor"]["R_s"], 0.5)
+
+
+@pytest.mark.parametrize(
+    "entry", ["V_dc = 48", "V_dc = 48.0", 'V_dc = "48 V"', 'p = "4"', "p = 4", "bits_current = 12"]
+)
+def test_one_actuator_has_one_hash_however_its_numbers_are_written(entry):
+    # the hash keys a calibration to its actuator: 48 and 48.0 volts are the same actuator
+    params = params_from_dict(tomllib.loads(entry))
+    assert params_hash(params) == params_hash(EmaParams())
+    assert type(params.motor.p) is int and type(params.inverter.V_dc) is float

@@ -62,6 +62,20 @@ def test_a_report_shows_the_verdict_faults_and_figures_and_needs_nothing_else(me
         assert src.startswith("data:image/png;base64,")
         assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
     assert not re.search(r'(?:src|href)="(?!data:)', page.read_text())
+    # the warnings and the input's conversion are shown
+    import dataclasses
+
+    warned = dataclasses.replace(result, warnings=["the offset looks 180 deg off"])
+    page = write_report(
+        warned, tmp_path / "rep2", provenance={"channel_map": "rig.toml", "conversion": {"θ0": 71.3}}
+    )
+    text = " ".join(_read(page).text)
+    assert (
+        "Warnings" in text
+        and "the offset looks 180 deg off" in text
+        and "rig.toml" in text
+        and "71.3" in text
+    )
 
 
 def test_a_recording_the_model_cannot_explain_reports_no_fault(measured, tmp_path):

@@ -137,7 +137,12 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
             raise InputError(
                 f"{where}: {key} = {raw!r} is outside the range emaphm accepts, {lo:g} to {hi:g} {si_unit}{hint}"
             )
-        values[group][key] = value
+        # the field's own type, so that 48, 48.0 and "48 V" are one actuator (one params_hash)
+        values[group][key] = (
+            int(value)
+            if isinstance(f.default, int) and float(value).is_integer()
+            else (value if isinstance(f.default, int) else float(value))
+        )
 
     for key, raw in data.items():
         if isinstance(raw, dict):

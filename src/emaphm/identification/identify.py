@@ -498,7 +498,10 @@ def identify(
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
     run = ident.run_
-    warnings = command_warnings(trace.t, trace.theta_cmd, monitor_model.calibration)
+    warnings = [
+        *(conversion or {}).get("warnings", []),
+        *command_warnings(trace.t, trace.theta_cmd, monitor_model.calibration),
+    ]
     if ident.compared_ < MIN_COMPARED:
         warnings.append(
             f"only {100 * ident.compared_:.0f} % of the recording is compared: the rest is a hold where "

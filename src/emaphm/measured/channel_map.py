@@ -248,6 +248,9 @@ def _check_roles(channels: Mapping[str, ChannelSpec], where: str) -> None:
     angle = "theta_e" in channels or "theta_m" in channels
     if "i_c" in channels and len(phases) < 2:
         raise InputError(f"{where}: channels.i_c needs i_a and i_b as well")
+    if len(phases) == 1:
+        other = "i_b" if phases[0] == "i_a" else "i_a"
+        raise InputError(f"{where}: channels.{phases[0]} needs {other} as well (two phases at least)")
     if "i_q" not in channels and not (len(phases) == 2 and angle):
         missing = [r for r in ("i_a", "i_b") if r not in channels] + ([] if angle else ["theta_e or theta_m"])
         raise InputError(

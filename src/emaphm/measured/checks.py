@@ -37,6 +37,7 @@ from .limits import (
     MIN_DURATION,
     OUTLIER_FACTOR,
     POSITION_FACTOR,
+    SPREAD_FLOOR,
 )
 
 __all__ = ["CURRENTS", "POSITIONS", "angle_ratio", "plausibility", "span_problems", "value_problems"]
@@ -67,12 +68,23 @@ def value_problems(
     med = float(np.median(v))
     lo, hi = (float(q) for q in np.percentile(v, [1.0, 99.0]))
     spread = hi - lo
-    if spread > 0:
-        far = np.abs(v - med) > OUTLIER_FACTOR * spread
+    # the spread, but never below 1 % of the channel's physical range: a recording that mostly
+    # rests (a long hold) has a percentile spread of sensor noise, against which its own motion
+    # would look corrupt
+    floor = (
+        SPREAD_FLOOR * params.controller.I_max
+        if role in CURRENTS
+        else SPREAD_FLOOR * params.transmission.theta_max
+        if role in POSITIONS
+        else 0.0
+    )
+    scale = max(spread, floor)
+    if scale > 0:
+        far = np.abs(v - med) > OUTLIER_FACTOR * scale
         if far.any():
             k = int(np.argmax(np.abs(v - med)))
             return [
-                f"{label}: {v[k]:.3g} at {row(int(finite[k]))} lies {abs(v[k] - med) / spread:.3g} times the "
+                f"{label}: {v[k]:.3g} at {row(int(finite[k]))} lies {abs(v[k] - med) / scale:.3g} times the "
                 f"signal's spread from its median ({int(far.sum())} such sample(s)): a corrupt sample? "
                 "remove it or set it to NaN"
             ]

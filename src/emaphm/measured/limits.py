@@ -20,6 +20,7 @@ __all__ = [
     "OUTLIER_FACTOR",
     "POSITION_FACTOR",
     "SATURATION_RUN",
+    "SPREAD_FLOOR",
     "ZERO_SEQUENCE_MAX",
     "as_dict",
 ]
@@ -34,6 +35,7 @@ CURRENT_FACTOR = 1.5  # |i| above 1.5 × I_max on more than FEW_SAMPLES samples:
 POSITION_FACTOR = 1.5  # |θ| above 1.5 × theta_max on more than FEW_SAMPLES samples: a unit error
 FEW_SAMPLES = 3  # isolated excursions tolerated by the range checks
 OUTLIER_FACTOR = 100.0  # a sample this many robust spreads away from the median is an outlier
+SPREAD_FLOOR = 0.01  # the robust spread is at least this fraction of I_max or theta_max (a long hold)
 SATURATION_RUN = 5  # equal samples at a channel's extreme: the sensor or ADC saturated
 ZERO_SEQUENCE_MAX = 0.05  # low-passed RMS(i_a + i_b + i_c) over the phase RMS (§D.3 item 6)
 ALIGNMENT_RESIDUAL_MAX = 0.25  # mean(i_d²)/mean(i_d² + i_q²) at the best θ0: the angle fits

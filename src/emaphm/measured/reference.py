@@ -157,8 +157,8 @@ def to_reference(
         signals["theta_u"] = to_grid("theta_u", *runs["theta_u"])
     else:
         warnings.append(
-            "theta_u is not mapped: the trace has no measured position (identify takes it as a SimResult; "
-            "emaphm.io.read_trace requires theta_u in a file)"
+            "theta_u is not mapped: the trace has no measured position, so holds of the command where the "
+            "surface rests are told from the command alone"
         )
     if "i_a" in m:
         t_cur, i_a = runs["i_a"]

@@ -75,10 +75,12 @@ class CsvSource(Source):
         self.header_line = k + 1  # 1-based line numbers in messages
         self.units: dict[str, str] = {}
         self.first_data_line = self.header_line + 1
-        rest = [line for line in head[k + 1 :] if line.strip()]
+        rest = [line for line in head[k + 1 :] if line.strip() and not line.lstrip().startswith("#")]
         if rest:
             cells = [c.strip().strip('"') for c in next(csv.reader([rest[0]], delimiter=self.delimiter))]
-            if all(
+            if cells and not cells[-1]:
+                cells = cells[:-1]  # a trailing delimiter
+            if cells and all(
                 c and c not in MISSING and _number(c) is None and _number(c.replace(",", ".")) is None
                 for c in cells
             ):
@@ -127,7 +129,7 @@ class CsvSource(Source):
                     self.path, delimiter=self.delimiter, skiprows=self.first_data_line - 1, usecols=usecols,
                     ndmin=2, comments="#", quotechar='"', encoding="utf-8-sig", dtype=np.float64,
                 )  # fmt: skip
-            if data.shape[0] == self._data_line_count():
+            if data.shape[0] == self._data_line_count(check_widths=True):
                 return data
         except ValueError:  # a bad cell, an empty cell, a decimal comma, a short row, not UTF-8
             pass
@@ -145,8 +147,21 @@ class CsvSource(Source):
                     continue
                 yield lineno, line
 
-    def _data_line_count(self) -> int:
-        return sum(1 for _ in self._data_lines())
+    def _data_line_count(self, *, check_widths: bool = False) -> int:
+        """The data rows; with `check_widths`, `InputError` for a row with more or fewer fields
+        than the header (numpy's reader takes the mapped columns of a shifted row as they come)."""
+        if not check_widths:
+            return sum(1 for _ in self._data_lines())
+        n, width, delim = 0, len(self.columns), self.delimiter
+        for lineno, line in self._data_lines():
+            n += 1
+            text = line.rstrip("\r\n")
+            fields = len(next(csv.reader([text], delimiter=delim))) if '"' in text else text.count(delim) + 1
+            if fields == width + 1 and text.endswith(delim):
+                fields -= 1  # a trailing delimiter
+            if fields != width:
+                raise InputError(f"{self.path}: line {lineno} has {fields} fields, the header has {width}")
+        return n
 
     def _parse_slow(self, usecols: list[int]) -> np.ndarray:
         rows: list[list[float]] = []
@@ -154,7 +169,9 @@ class CsvSource(Source):
         width = max(usecols) + 1
         for lineno, line in self._data_lines():
             cells = next(csv.reader([line.rstrip("\r\n")], delimiter=self.delimiter))
-            if len(cells) < width:
+            if len(cells) == len(self.columns) + 1 and not cells[-1].strip():
+                cells = cells[:-1]  # a trailing delimiter
+            if len(cells) != len(self.columns) or len(cells) < width:  # a shifted row: never read
                 raise InputError(
                     f"{self.path}: line {lineno} has {len(cells)} fields, the header has {len(self.columns)}"
                 )
