@@ -566,6 +566,122 @@ def _print_params(actuator: Any, source: str) -> None:
     _stdout_console().print(table)
 
 
+campaign_app = typer.Typer(
+    help="Fleet campaigns: many identifications from one file, on Dask, into a results store (docs/campaigns.md).",
+    no_args_is_help=True,
+)
+app.add_typer(campaign_app, name="campaign")
+
+
+@campaign_app.command("run")
+def campaign_run(
+    spec: Annotated[Path, typer.Argument(help="Campaign file (TOML).")],
+    out: Annotated[Path, typer.Option("--out", help="Folder of the results store (created if missing).")],
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            help="Dask scheduler address (default: DASK_SCHEDULER_ADDRESS, else a local cluster); 'serial': no Dask."
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(help="Local worker processes, one numba thread each (default: one per core)."),
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Print the summary as one JSON object.")] = False,
+) -> None:
+    """Run the jobs of a campaign that the store does not hold yet (a rerun completes an interrupted one).
+
+    Exit status 0 when every job is done, 1 when some failed (recorded in the store's failures;
+    a rerun tries them again).
+    """
+    import json
+
+    from .campaign import load_campaign, run_campaign
+
+    campaign = load_campaign(spec)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: exists and is not a folder")
+    if not out.absolute().parent.is_dir():
+        raise InputError(f"--out {out}: folder {out.absolute().parent} does not exist")
+    with _campaign_progress(campaign.name) as update:
+        summary = run_campaign(campaign, out, scheduler=scheduler, workers=workers, progress=update)
+    data = summary.to_json()
+    if json_out:
+        typer.echo(json.dumps(data))
+    err.print(
+        f"campaign {summary.campaign}: {summary.jobs} jobs, {summary.already_done} already done, "
+        f"{summary.done} done now, {summary.failed} failed ({summary.backend}, {summary.wall_time_s:.1f} s); "
+        f"store {out}"
+    )
+    if summary.failed:
+        err.print(f"emaphm: {summary.failed} job(s) failed: see 'emaphm campaign status {spec} {out}'")
+        raise typer.Exit(1)
+
+
+@campaign_app.command("status")
+def campaign_status_command(
+    spec: Annotated[Path, typer.Argument(help="Campaign file (TOML).")],
+    out: Annotated[Path, typer.Argument(help="Folder of the results store.")],
+    json_out: Annotated[bool, typer.Option("--json", help="Print the counts as one JSON object.")] = False,
+) -> None:
+    """Count the done, failed and missing jobs of a campaign in a results store."""
+    import json
+
+    from rich.table import Table
+
+    from .campaign import campaign_status
+
+    data = campaign_status(spec, out)
+    if json_out:
+        typer.echo(json.dumps(data))
+        return
+    table = Table(title=f"campaign {data['campaign']} in {data['store']}")
+    for column in ("actuator", "jobs", "done", "failed", "missing"):
+        table.add_column(column, justify="left" if column == "actuator" else "right")
+    for name, c in data["actuators"].items():
+        table.add_row(name, *(str(c[k]) for k in ("jobs", "done", "failed", "missing")))
+    table.add_row("all", *(str(data[k]) for k in ("jobs", "done", "failed", "missing")), style="bold")
+    out_console = _stdout_console()
+    out_console.print(table)
+    if data["other_rows"]:
+        out_console.print(
+            f"{data['other_rows']} stored row(s) belong to no job of this file (an older file or version)"
+        )
+
+
+@contextmanager
+def _campaign_progress(name: str) -> Iterator[Callable[[int, int, int, float], None]]:
+    """A bar with done / failed / remaining and the rate on a terminal; a line every 10 % in logs."""
+    if not err.is_terminal:
+        marks: set[int] = set()
+
+        def log(done: int, failed: int, total: int, elapsed: float) -> None:
+            tenth = (10 * (done + failed)) // max(total, 1)
+            if total and tenth not in marks:
+                marks.add(tenth)
+                rate = 3600.0 * (done + failed) / elapsed if elapsed > 0 else 0.0
+                err.print(
+                    f"{name}: {done} done, {failed} failed, {total - done - failed} remaining ({rate:.0f} jobs/h)"
+                )
+
+        yield log
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
+        TimeRemainingColumn(), console=err, transient=True,
+    ) as bar:  # fmt: skip
+        task = bar.add_task(f"campaign {name}", total=None, info="")
+
+        def update(done: int, failed: int, total: int, elapsed: float) -> None:
+            rate = 3600.0 * (done + failed) / elapsed if elapsed > 0 else 0.0
+            info = f"{failed} failed, {total - done - failed} remaining, {rate:.0f} jobs/h"
+            bar.update(task, total=total, completed=done + failed, info=info)
+
+        yield update
+
+
 def _fail(message: str, status: int) -> None:
     """One line on stderr (never wrapped), then exit with `status`."""
     sys.stderr.write("emaphm: error: " + " ".join(message.split()) + "\n")

@@ -1,0 +1,222 @@
+"""Running a campaign: the missing jobs only, on Dask (or in this process), into the results store.
+
+Backends (next-features §C):
+
+- **Dask** (``pip install 'emaphm[cluster]'``): an existing cluster by address (``scheduler=``
+  or ``DASK_SCHEDULER_ADDRESS``), or a `LocalCluster` of `workers` processes (default: one per
+  core) with one thread each. Dask sets OMP_NUM_THREADS=1 in its workers, but numba ignores it:
+  ``NUMBA_NUM_THREADS=1`` is set before the workers spawn, and each job runs on one numba thread
+  (`jobs.run_job`), so workers × threads never exceed the cores.
+- **serial**: the jobs one after the other in this process (``scheduler="serial"``, or one
+  worker and no address): no Dask needed.
+
+Only the jobs whose key is not in the store are submitted, so a rerun after any interruption
+(Ctrl-C, ``kill -9``, a dead worker) completes the campaign with every job exactly once. Rows are
+written by this process (workers need no shared file system) in batches, every `flush_rows`
+rows or `flush_seconds`, each batch atomically (`store.ResultStore.write`); an interruption
+loses at most the unflushed rows, which the rerun recomputes. A job that raises (or whose worker
+dies, `KilledWorker`) is written to ``failures`` and the campaign goes on; the rerun tries it again.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+from .jobs import failure_row, run_job
+from .spec import CampaignSpec, load_campaign
+from .store import ResultStore
+
+__all__ = ["CampaignSummary", "campaign_status", "run_campaign"]
+
+Progress = Callable[[int, int, int, float], None]  # done, failed, to do, elapsed [s]
+
+
+@dataclass(frozen=True)
+class CampaignSummary:
+    """What a run did."""
+
+    campaign: str
+    jobs: int
+    already_done: int
+    submitted: int
+    done: int
+    failed: int
+    wall_time_s: float
+    backend: str
+    workers: int
+
+    def to_json(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def _spec(spec: CampaignSpec | str | os.PathLike[str]) -> CampaignSpec:
+    return spec if isinstance(spec, CampaignSpec) else load_campaign(spec)
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def _warm_up() -> None:
+    """Load (or compile) every kernel once here, before workers start: concurrent first
+    compilations of a cached numba function race (numba #10128)."""
+    from ..faults import HEALTHY
+    from ..identification.identify import identify
+
+    identify(true_faults=HEALTHY, seed=0, pop_size=4, generations=1, local_polish=False, uncertainty="none",
+             workers=1)  # fmt: skip
+
+
+def run_campaign(
+    spec: CampaignSpec | str | os.PathLike[str],
+    out: str | os.PathLike[str],
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Progress | None = None,
+    flush_rows: int = 20,
+    flush_seconds: float = 10.0,
+) -> CampaignSummary:
+    """Run the jobs of `spec` that `out` does not hold yet; see the module docstring."""
+    spec = _spec(spec)
+    store = ResultStore(out)
+    jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work
+    address = scheduler if scheduler is not None else os.environ.get("DASK_SCHEDULER_ADDRESS") or None
+    cores = _cores()
+    if workers is not None and not 1 <= workers <= cores and address is None:
+        raise InputError(
+            f"--workers must be 1..{cores} on this machine (one numba thread each), got {workers}"
+        )
+    serial = address == "serial" or (address is None and workers == 1)
+    if not serial and address is None:
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise InputError(
+                "campaigns on several cores run on Dask: pip install 'emaphm[cluster]' (or --workers 1)"
+            ) from None
+    store.remove_temporaries()
+    done_keys = store.keys("results", spec.name)
+    todo = [j for j in jobs if j.key not in done_keys]
+    start = time.perf_counter()
+    rows: list[dict[str, Any]] = []
+    failures: list[dict[str, Any]] = []
+    counts = {"done": 0, "failed": 0}
+    last_flush = time.monotonic()
+
+    def flush(force: bool = False) -> None:
+        nonlocal rows, failures, last_flush
+        if force or len(rows) + len(failures) >= flush_rows or time.monotonic() - last_flush >= flush_seconds:
+            store.write("results", rows)
+            store.write("failures", failures)
+            rows, failures, last_flush = [], [], time.monotonic()
+
+    def finished(row: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
+        if row is not None:
+            rows.append(row)
+            counts["done"] += 1
+        if failure is not None:
+            failures.append(failure)
+            counts["failed"] += 1
+        flush()
+        if progress is not None:
+            progress(counts["done"], counts["failed"], len(todo), time.perf_counter() - start)
+
+    n_workers = 1
+    backend = "serial"
+    try:
+        if progress is not None:
+            progress(0, 0, len(todo), 0.0)
+        if todo and serial:
+            for job in todo:
+                payload = job.to_dict()
+                try:
+                    finished(run_job(payload), None)
+                except (InputError, ArithmeticError, RuntimeError, ValueError, OSError) as exc:
+                    finished(None, failure_row(payload, exc))
+        elif todo:
+            backend, n_workers = _run_dask(todo, address, workers or cores, finished)
+    finally:
+        flush(force=True)
+    return CampaignSummary(
+        campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo),
+        done=counts["done"], failed=counts["failed"], wall_time_s=round(time.perf_counter() - start, 3),
+        backend=backend, workers=n_workers,
+    )  # fmt: skip
+
+
+def _run_dask(
+    todo: list[Any], address: str | None, workers: int, finished: Callable[[Any, Any], None]
+) -> tuple[str, int]:
+    import dask
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if address is None:
+        _warm_up()
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": "1"}):
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+            )
+        client = Client(cluster)
+        backend = f"dask LocalCluster ({workers} workers x 1 thread)"
+    else:
+        try:
+            client = Client(address, timeout="10s")
+        except OSError as exc:
+            raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+        workers = max(1, len(client.scheduler_info().get("workers", {})))
+        backend = f"dask scheduler {address} ({workers} workers)"
+    try:
+        payloads = {job.key: job.to_dict() for job in todo}
+        futures = [
+            client.submit(run_job, payload, key=f"emaphm-{key}", pure=False)
+            for key, payload in payloads.items()
+        ]
+        for future in as_completed(futures):
+            payload = payloads[str(future.key).removeprefix("emaphm-")]
+            try:
+                row = future.result()
+            except Exception as exc:  # the job's own error, or KilledWorker: recorded, the campaign goes on
+                finished(None, failure_row(payload, exc))
+            else:
+                finished(row, None)
+    except BaseException:
+        client.cancel(futures) if "futures" in locals() else None
+        raise
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return backend, workers
+
+
+def campaign_status(
+    spec: CampaignSpec | str | os.PathLike[str], out: str | os.PathLike[str]
+) -> dict[str, Any]:
+    """Done, failed (and not done since) and missing jobs of `spec` in `out`, in all and per actuator;
+    ``other_rows``: stored rows of this campaign that no job of `spec` has (an older file or version)."""
+    spec = _spec(spec)
+    store = ResultStore(out)
+    jobs = spec.jobs()
+    done, failed_keys = store.keys("results", spec.name), store.keys("failures", spec.name)
+    per: dict[str, dict[str, int]] = {}
+    totals = {"jobs": len(jobs), "done": 0, "failed": 0, "missing": 0}
+    for job in jobs:
+        state = "done" if job.key in done else "failed" if job.key in failed_keys else "missing"
+        entry = per.setdefault(job.actuator, {"jobs": 0, "done": 0, "failed": 0, "missing": 0})
+        entry["jobs"] += 1
+        entry[state] += 1
+        totals[state] += 1
+    keys = {j.key for j in jobs}
+    rows = store.read("results", spec.name, columns=["job_key"]).num_rows
+    return {
+        "campaign": spec.name, "store": str(Path(out)), **totals, "stored_rows": rows,
+        "other_rows": len(done - keys), "actuators": per,
+    }  # fmt: skip

@@ -1,0 +1,135 @@
+"""The results store of campaigns: a Parquet dataset that survives any interruption (issue 11).
+
+Layout under the output folder::
+
+    results/campaign=<name>/actuator=<id>/part-<uuid>.parquet     one row per finished job
+    failures/campaign=<name>/actuator=<id>/part-<uuid>.parquet    one row per failed attempt
+
+Every part file is written whole to ``.part-<uuid>.parquet.tmp`` in its folder, flushed to disk
+and renamed into place (`os.replace`, atomic on one file system): a reader sees a complete file
+or none, and dataset discovery skips names that start with ``.``. A process killed mid-write
+(``kill -9``) leaves at most a temporary file, which the next run removes. Partition values are
+read back as strings (an explicit schema: pyarrow would read an actuator ``007`` as the
+integer 7).
+
+Columns of ``results`` (`RESULT_COLUMNS`): the job's key and coordinates, the estimate
+``k1``..``k8``, the truth ``true_k1``..``true_k8`` (null when not known), the uncertainty
+(``std_k*``, ``ci90_low_k*``, ``ci90_high_k*``; null when not computed), the verdict and the
+detected faults, ``fit_nrmse``, ``fitness``, ``evaluations``, ``wall_time_s``, the reference, the
+settings (JSON), the worker, the size of its numba thread pool (``numba_threads``: 1 on a
+campaign's workers, so that workers × threads stay within the cores) and the ``version``.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = ["FAILURE_COLUMNS", "RESULT_COLUMNS", "ResultStore"]
+
+K = [f"k{i}" for i in range(1, 9)]
+RESULT_COLUMNS: dict[str, str] = {
+    "job_key": "string", "flight": "int64", "seed": "int64", "identify_seed": "int64",
+    **{k: "float64" for k in K}, **{f"true_{k}": "float64" for k in K},
+    **{f"std_{k}": "float64" for k in K}, **{f"ci90_low_{k}": "float64" for k in K},
+    **{f"ci90_high_{k}": "float64" for k in K},
+    "uq_method": "string", "verdict": "string", "detected": "string", "fault_verdicts": "string",
+    "fit_nrmse": "float64", "fitness": "float64", "evaluations": "int64", "wall_time_s": "float64",
+    "reference": "string", "reference_sha256": "string", "settings": "string", "warnings": "string",
+    "worker": "string", "numba_threads": "int64", "finished": "string", "version": "string",
+}  # fmt: skip
+FAILURE_COLUMNS: dict[str, str] = {
+    "job_key": "string", "flight": "int64", "seed": "int64", "error": "string", "message": "string",
+    "worker": "string", "finished": "string", "version": "string",
+}  # fmt: skip
+PARTITIONS = ("campaign", "actuator")
+
+
+def _pyarrow() -> Any:
+    try:
+        import pyarrow as pa
+        import pyarrow.dataset as ds
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise InputError("campaigns store their results in Parquet: pip install 'emaphm[cluster]'") from None
+    return pa, ds, pq
+
+
+class ResultStore:
+    """The ``results`` and ``failures`` datasets under `root` (created on the first write)."""
+
+    def __init__(self, root: str | os.PathLike[str]) -> None:
+        self.root = Path(root)
+        if self.root.exists() and not self.root.is_dir():
+            raise InputError(f"{self.root}: exists and is not a folder")
+
+    # -- writing ----------------------------------------------------------------------------
+
+    def write(self, kind: str, rows: Sequence[dict[str, Any]]) -> list[Path]:
+        """Append `rows` (each with ``campaign`` and ``actuator``) to ``kind`` ("results" or
+        "failures"): one part file per actuator, each written atomically."""
+        if not rows:
+            return []
+        pa, _, pq = _pyarrow()
+        columns = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
+        schema = pa.schema([(name, getattr(pa, dtype)()) for name, dtype in columns.items()])
+        groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+        for row in rows:
+            groups.setdefault((row["campaign"], row["actuator"]), []).append(row)
+        written = []
+        for (campaign, actuator), group in groups.items():
+            folder = self.root / kind / f"campaign={campaign}" / f"actuator={actuator}"
+            folder.mkdir(parents=True, exist_ok=True)
+            table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in group], schema=schema)
+            name = f"part-{uuid.uuid4().hex}.parquet"
+            tmp = folder / f".{name}.tmp"
+            try:
+                with tmp.open("wb") as fh:
+                    pq.write_table(table, fh)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+                os.replace(tmp, folder / name)
+            finally:
+                tmp.unlink(missing_ok=True)
+            written.append(folder / name)
+        return written
+
+    def remove_temporaries(self) -> int:
+        """Delete the temporary files a killed run left behind; their number."""
+        removed = 0
+        for tmp in self.root.glob("*/campaign=*/actuator=*/.part-*.parquet.tmp"):
+            tmp.unlink(missing_ok=True)
+            removed += 1
+        return removed
+
+    # -- reading ----------------------------------------------------------------------------
+
+    def read(
+        self, kind: str = "results", campaign: str | None = None, columns: Iterable[str] | None = None
+    ) -> Any:
+        """The ``kind`` dataset as a pyarrow Table (empty if nothing was written), optionally of
+        one campaign and some columns; `InputError` naming a part file that cannot be read."""
+        pa, ds, _ = _pyarrow()
+        base = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
+        names = list(columns) if columns is not None else [*PARTITIONS, *base]
+        folder = self.root / kind
+        if not folder.is_dir():
+            types = {**base, "campaign": "string", "actuator": "string"}
+            return pa.table({n: pa.array([], type=getattr(pa, types[n])()) for n in names})
+        partitioning = ds.partitioning(pa.schema([(p, pa.string()) for p in PARTITIONS]), flavor="hive")
+        try:
+            data = ds.dataset(folder, format="parquet", partitioning=partitioning)
+            filt = (ds.field("campaign") == campaign) if campaign is not None else None
+            return data.to_table(columns=names, filter=filt)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise InputError(f"{folder}: a part file cannot be read ({exc})".splitlines()[0]) from None
+
+    def keys(self, kind: str = "results", campaign: str | None = None) -> set[str]:
+        """The job keys stored in ``kind`` (of one campaign)."""
+        table = self.read(kind, campaign, columns=["job_key"])
+        return {str(k) for k in table.column("job_key").to_pylist()}

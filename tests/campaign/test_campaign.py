@@ -1,0 +1,226 @@
+"""Fleet campaigns (issue 11): the file, the job keys, the store, resuming after any interruption, Dask."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import emaphm
+from emaphm.campaign import ResultStore, campaign_status, history_seed, load_campaign, run_campaign
+from emaphm.errors import InputError
+from tests.helpers import run_cli
+
+# a budget that makes a job ~0.1 s: the plumbing is tested here, not the accuracy
+FAST = 'pop_size = 6\ngenerations = 2\npolish = false\nuncertainty = "none"\n'
+SPEC = """[campaign]
+name = "fleet-t"
+seeds = [1, 2]
+
+[identify]
+{identify}
+[[actuator]]
+id = "A001"
+faults = [0.2, 0.1, 0, 0, 0, 0, 0, 0.5]
+
+[[actuator]]
+id = "007"
+faults = [0, 0, 0.3, 0, 0, 0, 0, 0.5]
+
+[[actuator]]
+id = "H1"
+flights = 4
+start  = [0.05, 0.02, 0, 0, 0, 0, 0, 0.5]
+growth = [0.01, 0.004, 0, 0, 0, 0, 0, -0.02]
+"""
+
+
+def write_spec(folder: Path, identify: str = FAST, extra: str = "") -> Path:
+    path = folder / "c.toml"
+    path.write_text(SPEC.format(identify=identify) + extra)
+    return path
+
+
+def test_a_history_expands_to_one_job_per_flight_and_seed(tmp_path):
+    spec = load_campaign(write_spec(tmp_path, extra='\n[[actuator]]\nid = "E"\nflights = 3\n'
+                                    'start = [0, 0, 0.1, 0, 0, 0, 0, 0.5]\ngrowth = [0.5, 0, 0.2, 0, 0, 0, 0, 0]\n'
+                                    'law = "exponential"\n'))  # fmt: skip
+    jobs = spec.jobs()
+    assert len(jobs) == 2 * (1 + 1 + 4 + 3) and len({j.key for j in jobs}) == len(jobs)
+    h1 = [j for j in jobs if j.actuator == "H1" and j.seed == 1]
+    assert [j.flight for j in h1] == [1, 2, 3, 4]
+    np.testing.assert_allclose(
+        [j.truth[0] for j in h1], [0.05, 0.06, 0.07, 0.08]
+    )  # linear: start + growth (n - 1)
+    np.testing.assert_allclose([j.truth[7] for j in h1], [0.5, 0.48, 0.46, 0.44])
+    e = [j for j in jobs if j.actuator == "E" and j.seed == 1]
+    np.testing.assert_allclose([j.truth[2] for j in e], 0.1 * np.exp(0.2 * np.arange(3)))  # exponential
+    assert [j.truth[0] for j in e] == [0.0, 0.0, 0.0]  # a fault at 0 stays at 0 under the exponential law
+    # a one-off measurement is identified with the campaign seed itself (as `emaphm identify --seed S`);
+    # each flight of a history with its own seed
+    assert [j.identify_seed for j in jobs if j.actuator == "A001"] == [1, 2]
+    assert len({j.identify_seed for j in h1}) == 4 and h1[2].identify_seed == history_seed(1, 3)
+
+
+def test_job_keys_are_content_keys(tmp_path):
+    keys = [j.key for j in load_campaign(write_spec(tmp_path)).jobs()]
+    assert keys == [j.key for j in load_campaign(write_spec(tmp_path)).jobs()]  # stable
+    moved = tmp_path / "elsewhere"
+    moved.mkdir()
+    assert keys == [j.key for j in load_campaign(write_spec(moved)).jobs()]  # not the file's place
+    other = [
+        j.key
+        for j in load_campaign(write_spec(tmp_path, FAST.replace("pop_size = 6", "pop_size = 7"))).jobs()
+    ]
+    assert not set(keys) & set(other)  # another setting: every key changes
+    # a recording's key follows its content, not its name
+    trace = emaphm.simulate(seed=1, duration=0.3)
+    emaphm.write_trace(trace, tmp_path / "r.h5")
+    ref = write_spec(tmp_path, extra='\n[[actuator]]\nid = "R"\nreference = "r.h5"\n')
+    before = [j.key for j in load_campaign(ref).jobs() if j.actuator == "R"]
+    emaphm.write_trace(emaphm.simulate(seed=2, duration=0.3), tmp_path / "r.h5")
+    assert not set(before) & {j.key for j in load_campaign(ref).jobs() if j.actuator == "R"}
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('[campaign]\nname = "x"\nseed = [1]\n[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]', "unknown key"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a b"\nfaults = [0,0,0,0,0,0,0,0.5]', "id must be"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n[[actuator]]\n'
+         'id = "a"\nfaults = [0,0,0,0,0,0,0,0.5]', "given twice: a"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\nflights = 3', "exactly one of"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,1.5]', "faults"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a"\nreference = "nope.h5"', "no such file"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "a"\nflights = 3\nstart = [0,0,0,0,0,0,0,0.5]\n'
+         'growth = [0,0,0,0,0,0,0,0]\nlaw = "cubic"', "law must be"),
+        ('[campaign]\nname = "x"\n[identify]\noptimiser = "ga"\n[[actuator]]\nid = "a"\n'
+         'faults = [0,0,0,0,0,0,0,0.5]', r"\[identify\] unknown key"),
+        ('[campaign]\nname = "x"\n[identify]\noptimizer = "sa"\n[[actuator]]\nid = "a"\n'
+         'faults = [0,0,0,0,0,0,0,0.5]', "optimizer"),
+        ('[campaign]\nname = "x"\n', "no \\[\\[actuator\\]\\]"),
+        ("[campaign\n", "not a valid TOML"),
+    ],
+)  # fmt: skip
+def test_a_bad_campaign_file_is_refused_in_one_line(tmp_path, text, match):
+    (tmp_path / "c.toml").write_text(text + "\n")
+    with pytest.raises(InputError, match=match) as exc:
+        load_campaign(tmp_path / "c.toml")
+    assert "\n" not in str(exc.value)
+
+
+def _check_store(out: Path, spec: Path) -> set[str]:
+    """Every part file readable, no key twice; the keys."""
+    table = ResultStore(out).read()
+    keys = table.column("job_key").to_pylist()
+    assert len(keys) == len(set(keys)), "a job stored twice"
+    assert set(table.column("actuator").to_pylist()) <= {"A001", "007", "H1"}  # "007" stays a string
+    assert set(keys) <= {j.key for j in load_campaign(spec).jobs()}
+    return set(keys)
+
+
+def test_a_campaign_resumes_after_an_interruption_with_every_job_exactly_once(tmp_path):
+    spec = write_spec(tmp_path)
+    out = tmp_path / "store"
+    calls = []
+
+    def stop_after_five(done, failed, todo, elapsed):
+        calls.append(done)
+        if done == 5:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_campaign(spec, out, workers=1, progress=stop_after_five, flush_rows=3)
+    assert len(_check_store(out, spec)) == 5  # the rows done before Ctrl-C were kept
+    summary = run_campaign(spec, out, workers=1)
+    assert summary.already_done == 5 and summary.submitted == 7 and summary.done == 7
+    assert len(_check_store(out, spec)) == 12
+    status = campaign_status(spec, out)
+    assert (status["done"], status["missing"], status["failed"], status["stored_rows"]) == (12, 0, 0, 12)
+
+
+RUNNER = """
+import sys
+from emaphm.campaign import run_campaign
+run_campaign(sys.argv[1], sys.argv[2], workers=1, flush_rows=1)
+"""
+
+
+def test_kill_9_at_any_moment_then_rerun_gives_every_job_once(tmp_path):
+    spec = write_spec(tmp_path)
+    out = tmp_path / "store"
+    rng = np.random.default_rng(11)
+    env = {**os.environ, "PYTHONHASHSEED": "0"}
+    stored = []
+    for target in (2, 5, 8, 10):  # kill once the store holds this many rows, then a random instant later
+        proc = subprocess.Popen([sys.executable, "-c", RUNNER, str(spec), str(out)], env=env)
+        deadline = time.monotonic() + 120
+        while proc.poll() is None and time.monotonic() < deadline:
+            if len(list(out.rglob("part-*.parquet"))) >= target:  # flush_rows=1: one file per job
+                time.sleep(float(rng.uniform(0.0, 0.15)))  # inside a job, or inside a write
+                break
+            time.sleep(0.01)
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+        stored.append(len(_check_store(out, spec)))
+    assert any(0 < n < 12 for n in stored), f"no kill landed inside the campaign: {stored}"
+    run_campaign(spec, out, workers=1)
+    assert len(_check_store(out, spec)) == 12
+    assert not list(out.rglob(".part-*.tmp"))  # the next run removed what a kill left
+
+
+def test_a_failing_job_is_recorded_and_the_campaign_goes_on(tmp_path, capsys):
+    trace = emaphm.simulate(seed=1, duration=0.3)
+    signals = dict(trace.signals)
+    emaphm.write_trace(emaphm.SimResult(t=trace.t, signals={**signals, "i_q": 1000 * signals["i_q"]}),
+                       tmp_path / "mA.h5")  # fmt: skip
+    spec = write_spec(tmp_path, extra='\n[[actuator]]\nid = "BAD"\nreference = "mA.h5"\n')
+    code, _, err = run_cli(
+        ["campaign", "run", str(spec), "--out", str(tmp_path / "s"), "--workers", "1"], capsys
+    )
+    assert code == 1 and "2 job(s) failed" in err
+    failures = ResultStore(tmp_path / "s").read("failures").to_pylist()
+    assert {f["actuator"] for f in failures} == {"BAD"} and "is the current in mA" in failures[0]["message"]
+    code, out, _ = run_cli(["campaign", "status", str(spec), str(tmp_path / "s"), "--json"], capsys)
+    data = json.loads(out)
+    assert code == 0 and (data["done"], data["failed"], data["missing"]) == (12, 2, 0)
+
+
+def test_a_campaign_job_gives_the_estimate_of_a_lone_identification(tmp_path):
+    spec = write_spec(tmp_path)
+    run_campaign(spec, tmp_path / "s", workers=1)
+    rows = {
+        (r["actuator"], r["flight"], r["seed"]): r for r in ResultStore(tmp_path / "s").read().to_pylist()
+    }
+    for (actuator, flight, seed), truth in (
+        (("007", 0, 2), [0, 0, 0.3, 0, 0, 0, 0, 0.5]),
+        (("H1", 3, 1), None),
+    ):
+        row = rows[(actuator, flight, seed)]
+        k = truth if truth is not None else [row[f"true_k{i}"] for i in range(1, 9)]
+        alone = emaphm.identify(true_faults=k, seed=row["identify_seed"], pop_size=6, generations=2,
+                                local_polish=False, uncertainty="none")  # fmt: skip
+        assert [row[f"k{i}"] for i in range(1, 9)] == alone.estimate.tolist()
+
+
+def test_dask_runs_the_same_jobs_on_one_numba_thread_per_worker(tmp_path):
+    pytest.importorskip("distributed")
+    spec = write_spec(tmp_path)
+    serial = run_campaign(spec, tmp_path / "serial", workers=1)
+    dask = run_campaign(spec, tmp_path / "dask", workers=2)
+    assert serial.done == dask.done == 12 and "dask" in dask.backend
+    a = {r["job_key"]: r for r in ResultStore(tmp_path / "serial").read().to_pylist()}
+    b = {r["job_key"]: r for r in ResultStore(tmp_path / "dask").read().to_pylist()}
+    assert a.keys() == b.keys()
+    for key in a:
+        assert [a[key][f"k{i}"] for i in range(1, 9)] == [b[key][f"k{i}"] for i in range(1, 9)]
+    assert {r["numba_threads"] for r in b.values()} == {1}  # workers x threads within the cores
+    assert len({r["worker"] for r in b.values()}) == 2
