@@ -103,8 +103,8 @@ def _value(raw: Any, key: str, si_unit: str, where: str) -> float | int:
             f"{where}: {key} = {raw!r}: unit {match.group(2)!r} is not one for {key} "
             f"(its unit is {si_unit}; accepted: {', '.join(table)})"
         )
-    value = number * table[unit]
-    return round(value) if float(value).is_integer() and si_unit == "bit" else value
+    # 12 significant digits: "1.8 mH" is 0.0018 H, not 0.0018000000000000002 (one actuator, one hash)
+    return float(f"{number * table[unit]:.12g}")
 
 
 def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaParams:
@@ -158,7 +158,13 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
         raise InputError(f"{where}: {exc}") from None
 
 
+# the unit a value out of range was most likely meant in, for the hint
+_LIKELY = {"rad": "deg", "A/rad": "A/deg", "A/(rad·s)": "A/(deg·s)", "A·s/rad": "A·s/deg"}
+
+
 def _example_unit(si_unit: str) -> str:
+    if si_unit in _LIKELY:
+        return _LIKELY[si_unit]
     others = [u for u in UNITS[si_unit] if u != si_unit]
     return others[0] if others else si_unit
 

@@ -39,7 +39,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-err = Console(stderr=True, highlight=False)
+err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
 
 # literals, so that the CLI starts without numpy (tests/test_cli.py checks them against the code)
 HEALTHY_TEXT = "0,0,0,0,0,0,0,0.5"  # emaphm.faults.HEALTHY
@@ -167,7 +167,11 @@ def identify(
         typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
     ] = None,
 ) -> None:
-    """Identify the fault vector from a measured (or simulated) quadrature current."""
+    """Identify the fault vector from a measured (or simulated) quadrature current.
+
+    Exit status 0 with a diagnosis, 2 for bad input (nothing run), 3 when the monitor cannot
+    explain the recording (verdict "does not fit": no faults are reported).
+    """
     import json
 
     from .faults import parse_faults
@@ -253,6 +257,11 @@ def _print_identification(data: dict[str, Any]) -> None:
     out.print(table)
     if data["percent_error"] is not None:
         out.print(f"%err {data['percent_error']:.2f}")
+    if data["fit_nrmse"] is not None:
+        out.print(
+            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 2-6 %; "
+            "above 50 %: does not fit)"
+        )
     if data["verdict"] != "fits":
         out.print("verdict: does not fit (see the warning): no faults reported")
     else:

@@ -176,7 +176,7 @@ def _page(data: dict[str, Any], figures: dict[str, bytes], provenance: dict[str,
         "<h2>Input</h2>",
         f"<pre>{e(json.dumps(provenance, indent=2, default=str))}</pre>",
         "<h2>Settings</h2>",
-        f"<pre>{e(json.dumps(data['settings'], indent=2, default=str))}</pre>",
+        f"<pre>{e(json.dumps({k: v for k, v in data['settings'].items() if k != 'conversion'}, indent=2, default=str))}</pre>",
         "</body></html>",
     ]
     return "\n".join(parts) + "\n"

@@ -86,3 +86,27 @@ def cmap_file(path):
     from emaphm.measured import ChannelMap
 
     return ChannelMap.load(path)
+
+
+def test_a_gap_that_cuts_the_record_is_said_loudly(tmp_path, twin):
+    # newcomer: rows 0.4-0.5 s missing gave "fits" and a wrong diagnosis with nothing on the terminal
+    c = twin_columns(twin)
+    keep = (c["t"] < 0.4) | (c["t"] >= 0.5)
+    path = write_csv(tmp_path / "gap.csv", {k: c[k][keep] for k in SIGNALS})
+    report = to_reference(load_measurement(path, cmap(si_map()))).report
+    assert "segment_cut" in report["flags"]
+    (warning,) = [w for w in report["warnings"] if "split the record" in w]
+    assert "0.5..1 s (50 % of it)" in warning and "starts inside the command" in warning
+
+
+def test_values_with_units_round_to_the_number_meant():
+    import tomllib
+
+    from emaphm.actuator import params_from_dict
+    from emaphm.calibration import params_hash
+
+    a = params_from_dict(tomllib.loads('L_s = "1.8 mH"\nf_s = "20 kHz"'))
+    b = params_from_dict(tomllib.loads("L_s = 0.0018\nf_s = 20000"))
+    assert a.motor.L_s == 0.0018 and params_hash(a) == params_hash(b)
+    with pytest.raises(InputError, match=r'theta_max = "28\.6 deg"'):
+        params_from_dict(tomllib.loads("theta_max = 28.6"))  # the hint names the unit meant

@@ -168,7 +168,8 @@ def phases_to_iq(
         hint = (
             "check angle.offset"
             if offset is not None
-            else "wrong pole pairs p, an angle counting the other way (scale = -1), or not the rotor angle"
+            else "wrong pole pairs p, an angle counting the other way (scale = -1), phases in another order "
+            "(i_a and i_b swapped), or not the rotor angle"
         )
         raise InputError(
             f"the angle does not follow the current vector: mean(i_d^2) is {100 * residual:.0f} % of the "

@@ -152,7 +152,7 @@ def angle_ratio(
         hint = (
             "is it the surface angle?"
             if ratio < expected / 20
-            else f"check the pole pairs p = {p}, the gear ratio tau = {tau:g} and the unit of {angle_role}"
+            else f"check the pole pairs p = {p}, the gear ratio tau = {tau:g}, and the units of {angle_role} and {ref_role}"
         )
         return f"{angle_role} turns {ratio:.3g}× {which}, expected {name} = {expected:g}: {hint}", info
     if ref_role == "theta_u" and corr < -0.5:

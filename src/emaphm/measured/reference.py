@@ -160,6 +160,8 @@ def to_reference(
             "theta_u is not mapped: the trace has no measured position, so holds of the command where the "
             "surface rests are told from the command alone"
         )
+    if "i_a" in m and "i_q" in m:
+        warnings.append("the map gives i_q and the phase currents: i_q is used, the phases only stored")
     if "i_a" in m:
         t_cur, i_a = runs["i_a"]
         i_b = _at(runs["i_b"], t_cur)
@@ -187,7 +189,22 @@ def to_reference(
 
     t = t_abs - seg.start
     report = _report(m, params, f_s, seg, candidates, breaks, n, resampling, alignment_report, angle_info)
-    report["flags"] = flags + (["segment_cut"] if report["segments"]["dropped_s"] > 1.0 / f_s else [])
+    cut = report["segments"]["dropped_s"] > 1.0 / f_s
+    report["flags"] = flags + (["segment_cut"] if cut else [])
+    if cut:
+        first, last = report["segments"]["record"]
+        used = report["segments"]["used"]
+        share = 100.0 * (used[1] - used[0]) / (last - first) if last > first else 100.0
+        late = used[0] - first > 1.0 / f_s
+        warnings.append(
+            f"gaps or NaN runs split the record: only {used[0]:g}..{used[1]:g} s ({share:.0f} % of it) is used"
+            + (
+                "; it starts inside the command, where the monitor starts from rest: the diagnosis is unreliable "
+                "unless the command was at rest there"
+                if late
+                else ""
+            )
+        )
     report["warnings"] = warnings
     metadata = {
         "model": "measured",
