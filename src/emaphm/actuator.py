@@ -28,7 +28,15 @@ from typing import Any
 from .errors import InputError
 from .params import EmaParams
 
-__all__ = ["ACCEPTED", "UNITS", "load_params", "params_from_dict", "params_template", "resolve_params"]
+__all__ = [
+    "ACCEPTED",
+    "UNITS",
+    "load_params",
+    "load_thresholds",
+    "params_from_dict",
+    "params_template",
+    "resolve_params",
+]
 
 _DEG = math.pi / 180.0
 
@@ -145,6 +153,8 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
         )
 
     for key, raw in data.items():
+        if key == "thresholds":  # the failure thresholds of prognostics: `load_thresholds`
+            continue
         if isinstance(raw, dict):
             if key not in groups:
                 raise InputError(f"{where}: unknown table [{key}]; the tables are {', '.join(groups)}")
@@ -222,3 +232,16 @@ def params_template(params: EmaParams | None = None) -> str:
         for name, value, meta in entries:
             lines.append(f"{name} = {value}".ljust(width) + f"  # [{meta['unit']}] {meta['doc']}")
     return "\n".join(lines) + "\n"
+
+
+def load_thresholds(path: str | os.PathLike[str]) -> dict[str, float]:
+    """The ``[thresholds]`` table of an actuator file: failure thresholds per fault, as distances
+    from healthy in fault units (``friction = 0.45``); {} when the file has none."""
+    from .prognostics.rul import parse_thresholds
+
+    p = Path(path)
+    load_params(p)  # the whole file is valid
+    data = tomllib.loads(p.read_text(encoding="utf-8")).get("thresholds", {})
+    if not isinstance(data, dict):
+        raise InputError(f"{p}: [thresholds] must be a table of FAULT = distance from healthy")
+    return parse_thresholds(data, where=f"{p}: [thresholds]")

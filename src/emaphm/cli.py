@@ -575,6 +575,107 @@ def _print_params(actuator: Any, source: str) -> None:
     _stdout_console().print(table)
 
 
+@app.command()
+def rul(
+    store: Annotated[
+        Path, typer.Argument(help="Folder of a campaign's results store (emaphm campaign run --out).")
+    ],
+    actuator: Annotated[str, typer.Option(help="The actuator's id in the store.")],
+    campaign: Annotated[
+        str | None, typer.Option(help="The campaign, when the actuator is in several.")
+    ] = None,
+    at_flight: Annotated[
+        int | None, typer.Option(help="Predict as of this flight (default: the last stored).")
+    ] = None,
+    threshold: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="A failure threshold FAULT=DISTANCE from healthy, e.g. friction=0.45 (repeatable)."
+        ),
+    ] = None,
+    params: Annotated[
+        Path | None,
+        typer.Option("--params", help="Actuator file whose [thresholds] table gives the thresholds."),
+    ] = None,
+    inspection_interval: Annotated[
+        float, typer.Option(help="Flights to the next inspection, for the probability of failing before it.")
+    ] = 10.0,
+    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    plot: Annotated[Path | None, typer.Option(help="Write the prognosis figure here (.png).")] = None,
+) -> None:
+    """Remaining useful life of an actuator from its history of diagnoses: per fault and for the first failure."""
+    import json
+
+    from .io import check_output_path
+    from .prognostics.rul import parse_thresholds, rul_report
+
+    if plot is not None:
+        check_output_path(plot, suffixes=(".png",), option="--plot")
+    if not inspection_interval > 0:
+        raise InputError(f"--inspection-interval must be > 0 flights, got {inspection_interval}")
+    given: dict[str, float] = {}
+    if params is not None:
+        from .actuator import load_thresholds
+
+        given.update(load_thresholds(params))
+    given.update(parse_thresholds(threshold))
+    report = rul_report(store, actuator, campaign=campaign, at_flight=at_flight, thresholds=given,
+                        inspection_interval=inspection_interval)  # fmt: skip
+    data = {k: v for k, v in report.items() if not k.startswith("_")}
+    if plot is not None:
+        from .plots import plot_rul
+
+        plot_rul(report, plot)
+        err.print(f"wrote {plot}")
+    if json_out:
+        typer.echo(json.dumps(data))
+        return
+    _print_rul(data)
+
+
+def _print_rul(data: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    def num(v: Any) -> str:
+        return "beyond" if v is None else f"{v:.1f}"
+
+    table = Table(
+        title=f"actuator {data['actuator']} ({data['campaign']}), as of flight {data['at_flight']:g}"
+    )
+    for column in (
+        "fault",
+        "law",
+        "threshold",
+        "tracked from",
+        "RUL median",
+        "RUL 5-95 %",
+        "P(fail before next)",
+    ):
+        table.add_column(column, justify="left" if column in ("fault", "law") else "right")
+    for name, f in data["faults"].items():
+        threshold = f"{f['threshold']:g}" + (" (placeholder)" if f["placeholder"] else "")
+        if f["status"] != "tracked":
+            table.add_row(name, f["law"], threshold, f["status"], "-", "-", "-")
+            continue
+        table.add_row(
+            name, f["law"], threshold, str(f["tracked_from"]), num(f["rul_median"]),
+            f"{num(f['rul_p05'])}-{num(f['rul_p95'])}", f"{f['prob_fail_before_next_inspection']:.2f}",
+        )  # fmt: skip
+    out = _stdout_console()
+    out.print(table)
+    first = data["first_failure"]
+    if first["status"] == "tracked":
+        out.print(
+            f"first failure: median {num(first['rul_median'])} flights (5-95 % {num(first['rul_p05'])}-"
+            f"{num(first['rul_p95'])}), most likely {first['most_likely_fault']}; P(before the next inspection in "
+            f"{data['inspection_interval']:g} flights) {first['prob_fail_before_next_inspection']:.2f}"
+        )
+        if first["placeholder_thresholds"]:
+            out.print(f"placeholder thresholds (not limits): {', '.join(first['placeholder_thresholds'])}")
+    else:
+        out.print("no fault is tracked yet: nothing is predicted")
+
+
 campaign_app = typer.Typer(
     help="Fleet campaigns: many identifications from one file, on Dask, into a results store (docs/campaigns.md).",
     no_args_is_help=True,

@@ -177,3 +177,48 @@ def plot_vectors(
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_rul(report: dict, path: Path) -> Path:
+    """An actuator's prognosis (`prognostics.rul_report`): per tracked fault its measurements with
+    90 % whiskers, the fitted law with its band up to the crossing, the threshold and the RUL's
+    5-95 % range; below, the distribution of the flights to the first failure."""
+    plt = _pyplot()
+    trends = report["_trends"]
+    estimates = report["_estimates"]
+    n = len(trends)
+    fig, axes = plt.subplots(n + 1, 1, figsize=(9, 2.6 * (n + 1)), layout="constrained", squeeze=False)
+    t_now = report["at_flight"]
+    for ax, (name, trend) in zip(axes[:-1, 0], trends.items(), strict=False):
+        f = report["faults"][name]
+        est = estimates[name]
+        t = np.asarray(trend.t)
+        end = t_now + (est.p95 if np.isfinite(est.p95) else 2 * (t_now - t.min() + 1))
+        grid = np.linspace(t.min(), max(end, t_now + 1), 200)
+        lo, hi = trend.band(grid)
+        ax.errorbar(t, trend.k, yerr=1.645 * np.asarray(trend.sd), fmt="o", ms=3, color="k", elinewidth=0.7,
+                    label="identified (90 % interval)")  # fmt: skip
+        ax.plot(grid, trend.value(grid), "C0", lw=1.2, label=f"{f['law']} law")
+        ax.fill_between(grid, lo, hi, color="C0", alpha=0.15, lw=0)
+        mark = " (placeholder)" if f["placeholder"] else ""
+        ax.axhline(f["threshold"], color="C3", lw=1, ls="--", label=f"threshold {f['threshold']:g}{mark}")
+        ax.axvline(t_now, color="0.5", lw=0.8)
+        if np.isfinite(est.p05):
+            ax.axvspan(t_now + est.p05, t_now + min(est.p95, grid[-1] - t_now), color="C3", alpha=0.08,
+                       label="RUL 5-95 %")  # fmt: skip
+        ax.set_ylabel(f"{name}\n|k - healthy|")
+        ax.legend(fontsize=7, loc="upper left")
+        ax.grid(alpha=0.3)
+    ax = axes[-1, 0]
+    first = estimates.get("first failure")
+    if first is not None:
+        finite = first.samples[np.isfinite(first.samples)]
+        if len(finite):
+            ax.hist(finite, bins=50, color="C3", alpha=0.7)
+        ax.set_title(f"flights to the first failure from flight {t_now:g}: median {first.median:.1f}, "
+                     f"5-95 % {first.p05:.1f}-{first.p95:.1f}", fontsize=9)  # fmt: skip
+    ax.set_xlabel("flights")
+    fig.suptitle(f"actuator {report['actuator']} ({report['campaign']})", fontsize=10)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -50,6 +50,8 @@ class CampaignSummary:
     wall_time_s: float
     backend: str
     workers: int
+    # of the wall time, the start of the cluster (and the compile-cache warm-up) before the first job
+    startup_s: float = 0.0
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -130,6 +132,7 @@ def run_campaign(
 
     n_workers = 1
     backend = "serial"
+    ready = {"at": start}
     try:
         if progress is not None:
             progress(0, 0, len(todo), 0.0)
@@ -141,18 +144,22 @@ def run_campaign(
                 except (InputError, ArithmeticError, RuntimeError, ValueError, OSError) as exc:
                     finished(None, failure_row(payload, exc))
         elif todo:
-            backend, n_workers = _run_dask(todo, address, workers or cores, finished)
+            backend, n_workers = _run_dask(todo, address, workers or cores, finished, ready)
     finally:
         flush(force=True)
     return CampaignSummary(
         campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo),
         done=counts["done"], failed=counts["failed"], wall_time_s=round(time.perf_counter() - start, 3),
-        backend=backend, workers=n_workers,
+        backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
     )  # fmt: skip
 
 
 def _run_dask(
-    todo: list[Any], address: str | None, workers: int, finished: Callable[[Any, Any], None]
+    todo: list[Any],
+    address: str | None,
+    workers: int,
+    finished: Callable[[Any, Any], None],
+    ready: dict[str, float],
 ) -> tuple[str, int]:
     import dask
     from distributed import Client, LocalCluster, as_completed
@@ -160,7 +167,16 @@ def _run_dask(
     cluster = None
     if address is None:
         _warm_up()
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": "1"}):
+        # one numba thread per worker (numba ignores the OMP_NUM_THREADS=1 Dask sets), and no
+        # statistical profiler: it samples every task thread every 10 ms, which slowed
+        # identifications by 11 % on 2 cores (BENCHMARKS.md, "Fleet campaigns")
+        with dask.config.set({
+            "distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": "1",
+            "distributed.worker.profile.enabled": False,
+            # the event loop's housekeeping wakes less often (it takes the GIL from the job)
+            "distributed.admin.tick.interval": "500ms",
+            "distributed.admin.system-monitor.interval": "2s",
+        }):  # fmt: skip
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
             )
@@ -173,6 +189,12 @@ def _run_dask(
             raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
         workers = max(1, len(client.scheduler_info().get("workers", {})))
         backend = f"dask scheduler {address} ({workers} workers)"
+    if cluster is not None:
+        client.wait_for_workers(workers)
+    # each worker imports emaphm and loads the compiled kernels before the first job (2-3 s a
+    # process), so that jobs are timed and balanced on warm workers
+    client.run(_warm_up)
+    ready["at"] = time.perf_counter()
     try:
         payloads = {job.key: job.to_dict() for job in todo}
         futures = [

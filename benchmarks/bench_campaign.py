@@ -1,0 +1,92 @@
+"""Campaign throughput on this machine: Dask LocalCluster vs a plain serial loop of the same jobs (issue 11).
+
+    python benchmarks/bench_campaign.py [--jobs 16] [--tiny 60] [--case-seed 5101]
+
+1. Throughput. --jobs random multi-fault actuators on the twin (DESIGN §7 ranges, the script's own
+   seed), each identified as ``emaphm identify --true-faults K --seed 1`` does (default budget,
+   Laplace intervals), run twice: a plain serial loop in this process on one numba thread, and
+   ``run_campaign`` on a LocalCluster of one worker per core (one numba thread each). Printed:
+   identifications per hour of each, their ratio (target >= 1.8x on 2 cores, goal >= 1.95x),
+   with and without the cluster's start.
+2. Overhead per job. --tiny jobs of a few ms of work (pop 4 x 1 generation, no polish, no
+   intervals, a 0.2 s chirp) through the same campaign: (loop wall x workers - the jobs' own
+   wall time) / jobs, the cluster's start excluded (target <= 50 ms).
+The estimates of both runs are compared (they must be identical).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+
+import emaphm
+from emaphm.campaign import ResultStore, load_campaign, run_campaign
+from emaphm.campaign.jobs import run_job
+from emaphm.faults import random_faults
+
+
+def spec_file(folder: Path, name: str, cases: np.ndarray, identify: str = "") -> Path:
+    text = f'[campaign]\nname = "{name}"\nseeds = [1]\n\n[identify]\n{identify}\n'
+    for j, k in enumerate(cases):
+        text += f'[[actuator]]\nid = "C{j:03d}"\nfaults = [{", ".join(f"{v:.6f}" for v in k)}]\n\n'
+    path = folder / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--jobs", type=int, default=16)
+    parser.add_argument("--tiny", type=int, default=60)
+    parser.add_argument("--case-seed", type=int, default=5101)
+    args = parser.parse_args()
+    cores = len(os.sched_getaffinity(0))
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {cores} cores ({cpu_model()}); "
+          f"{args.jobs} jobs (seed {args.case_seed}), {args.tiny} tiny jobs")  # fmt: skip
+    with tempfile.TemporaryDirectory() as name:
+        tmp = Path(name)
+        spec = spec_file(tmp, "bench", random_faults(args.jobs, args.case_seed))
+        jobs = load_campaign(spec).jobs()
+        run_job(jobs[0].to_dict())  # compile cache loaded, as the campaign's warm-up does
+        t0 = time.perf_counter()
+        serial = {j.key: run_job(j.to_dict()) for j in jobs}
+        t_serial = time.perf_counter() - t0
+        summary = run_campaign(spec, tmp / "store", workers=cores)
+        rows = {r["job_key"]: r for r in ResultStore(tmp / "store").read().to_pylist()}
+        same = all(
+            [rows[k][f"k{i}"] for i in range(1, 9)] == [serial[k][f"k{i}"] for i in range(1, 9)]
+            for k in serial
+        )
+        loop = summary.wall_time_s - summary.startup_s
+        per_h = 3600.0 * len(jobs)
+        print(f"serial loop, 1 thread: {t_serial:.1f} s, {per_h / t_serial:.0f} identifications/h "
+              f"(median job {np.median([r['wall_time_s'] for r in serial.values()]):.2f} s)")  # fmt: skip
+        print(f"campaign, {summary.backend}: {summary.wall_time_s:.1f} s of which {summary.startup_s:.1f} s start, "
+              f"{per_h / summary.wall_time_s:.0f} identifications/h ({per_h / loop:.0f} without the start)")  # fmt: skip
+        print(f"throughput ratio campaign / serial: {t_serial / summary.wall_time_s:.2f}x with the start, "
+              f"{t_serial / loop:.2f}x without; estimates identical: {same}")  # fmt: skip
+        own_c = sum(r["wall_time_s"] for r in rows.values())
+        own_s = sum(r["wall_time_s"] for r in serial.values())
+        print(f"the jobs' own time: {own_s:.1f} s serial, {own_c:.1f} s in the campaign ({own_c / own_s:.2f}x: two "
+              f"jobs at once slow each other); busy share of the {summary.workers} workers "
+              f"{own_c / (loop * summary.workers):.3f}")  # fmt: skip
+
+        tiny = spec_file(tmp, "tiny", random_faults(args.tiny, args.case_seed + 1),
+                         'pop_size = 4\ngenerations = 1\npolish = false\nuncertainty = "none"\n')  # fmt: skip
+        small = run_campaign(tiny, tmp / "store", workers=cores)
+        own = sum(r["wall_time_s"] for r in ResultStore(tmp / "store").read("results", "tiny").to_pylist())
+        loop = small.wall_time_s - small.startup_s
+        print(f"tiny jobs: {small.done} in {loop:.2f} s after a {small.startup_s:.1f} s start on {small.workers} "
+              f"workers; their own time {own:.2f} s; overhead per job "
+              f"{1000 * (loop * small.workers - own) / small.done:.1f} ms")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

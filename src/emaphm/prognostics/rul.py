@@ -1,0 +1,192 @@
+"""From a history of diagnoses in a campaign store to remaining useful life (issue 12).
+
+For one actuator of a results store (`emaphm.campaign`), each fault is tracked from its first
+detection (verdict "present"): its later identifications, each with its standard deviation
+(the calibrated 90 % interval's), enter a `DegradationTrend` with the fault's law; a measurement
+the identification could not size (flag ``non_identifiable``, no interval, or a verdict "does not
+fit") carries no information and is left out. The trend's crossing of the fault's failure
+threshold gives the RUL in flights, per fault and for the first failure.
+
+Failure thresholds, as distances from healthy in fault units: given (``--threshold``, or the
+``[thresholds]`` table of the actuator file), or the placeholders of `PLACEHOLDER_THRESHOLDS`
+(next-features §B.3), which every output marks ``"placeholder": true``: a placeholder is not an
+airworthiness limit.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .trend import DegradationTrend, RulEstimate
+
+__all__ = ["FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "rul_report"]
+
+# tracked faults: name -> (column, law, healthy value); k7 (a direction) is not a damage
+FAULTS: dict[str, tuple[str, str, float]] = {
+    "friction": ("k1", "linear", 0.0),
+    "backlash": ("k2", "linear", 0.0),
+    "short_a": ("k3", "exponential", 0.0),
+    "short_b": ("k4", "exponential", 0.0),
+    "short_c": ("k5", "exponential", 0.0),
+    "eccentricity": ("k6", "linear", 0.0),
+    "kp_drift": ("k8", "linear", 0.5),
+}
+# distances from healthy at which each fault fails, when none is given (next-features §B.3):
+# friction and backlash are actuator- and airframe-specific, shorts self-accelerate past a fifth
+# of a winding, eccentricity well before a rub, gain drift past its stability margin
+PLACEHOLDER_THRESHOLDS: dict[str, float] = {
+    "friction": 0.5, "backlash": 0.25, "short_a": 0.2, "short_b": 0.2, "short_c": 0.2,
+    "eccentricity": 0.3, "kp_drift": 0.3,
+}  # fmt: skip
+SAMPLES = 4000
+
+
+def parse_thresholds(
+    items: list[str] | dict[str, Any] | None, where: str = "--threshold"
+) -> dict[str, float]:
+    """{"friction": 0.45, ...} from ``["friction=0.45", ...]`` or a dict; `InputError` naming a bad one."""
+    if not items:
+        return {}
+    pairs = items.items() if isinstance(items, dict) else (_split(s, where) for s in items)
+    out = {}
+    for name, value in pairs:
+        if name not in FAULTS:
+            raise InputError(f"{where}: unknown fault {name!r}; choose from {', '.join(FAULTS)}")
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"{where}: {name} = {value!r} is not a number") from None
+        if not (math.isfinite(v) and 0 < v <= 1):
+            raise InputError(f"{where}: {name} = {v!r} must be a distance from healthy in (0, 1]")
+        out[name] = v
+    return out
+
+
+def _split(item: str, where: str) -> tuple[str, str]:
+    if "=" not in item:
+        raise InputError(f"{where}: {item!r} must be FAULT=VALUE, e.g. friction=0.45")
+    name, value = item.split("=", 1)
+    return name.strip(), value.strip()
+
+
+def history(
+    store: str | os.PathLike[str], actuator: str, campaign: str | None = None
+) -> list[dict[str, Any]]:
+    """The actuator's rows of a results store, sorted by flight (one-off measurements, flight 0, left out)."""
+    from ..campaign.store import ResultStore
+
+    rows = [r for r in ResultStore(store).read("results", campaign).to_pylist() if r["actuator"] == actuator]
+    if not rows:
+        raise InputError(
+            f"{store}: no results for actuator {actuator!r}"
+            + (f" in campaign {campaign!r}" if campaign else "")
+        )
+    campaigns = sorted({r["campaign"] for r in rows})
+    if len(campaigns) > 1:
+        raise InputError(
+            f"actuator {actuator!r} is in campaigns {', '.join(campaigns)}: choose one with --campaign"
+        )
+    rows = [r for r in rows if r["flight"] >= 1]
+    if not rows:
+        raise InputError(f"actuator {actuator!r} has no history over flights (only one-off measurements)")
+    return sorted(rows, key=lambda r: (r["flight"], r["seed"]))
+
+
+def _measurement(row: dict[str, Any], name: str) -> tuple[float, float] | None:
+    """(value, sd) of a fault in one row, or None where the row tells nothing about it."""
+    column = FAULTS[name][0]
+    j = int(column[1:]) - 1
+    if row.get("verdict") != "fits":
+        return None
+    flags = json.loads(row["uq_flags"]) if row.get("uq_flags") else None
+    if flags is not None and "non_identifiable" in flags[j]:
+        return None
+    sd = row.get(f"std_{column}")
+    if sd is None or not math.isfinite(sd) or sd <= 0:
+        return None
+    return float(row[column]), float(sd)
+
+
+def _detected(row: dict[str, Any], name: str) -> bool:
+    verdicts = json.loads(row["fault_verdicts"]) if row.get("fault_verdicts") else None
+    if verdicts is not None:
+        return bool(verdicts.get(name) == "present")
+    return name in (row.get("detected") or "").split(",")
+
+
+def rul_report(
+    store: str | os.PathLike[str],
+    actuator: str,
+    *,
+    campaign: str | None = None,
+    at_flight: int | None = None,
+    thresholds: dict[str, float] | None = None,
+    inspection_interval: float = 10.0,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """The RUL of each tracked fault and of the first failure, as of flight `at_flight` (default:
+    the last one stored), JSON-ready; see the module docstring. ``_trends`` and ``_estimates``
+    (not JSON) hold the fitted trends and the draws, for a plot."""
+    rows = history(store, actuator, campaign)
+    if at_flight is not None:
+        rows = [r for r in rows if r["flight"] <= at_flight]
+        if not rows:
+            raise InputError(f"actuator {actuator!r} has no flight at or before {at_flight}")
+    t_now = float(at_flight if at_flight is not None else rows[-1]["flight"])
+    given = dict(thresholds or {})
+    faults: dict[str, Any] = {}
+    trends: dict[str, DegradationTrend] = {}
+    estimates: dict[str, RulEstimate] = {}
+    for name, (_, law, healthy) in FAULTS.items():
+        threshold = given.get(name, PLACEHOLDER_THRESHOLDS[name])
+        entry: dict[str, Any] = {"law": law, "threshold": threshold, "placeholder": name not in given}
+        onset = next((r["flight"] for r in rows if _detected(r, name)), None)
+        if onset is None:
+            faults[name] = {
+                **entry,
+                "status": "not detected",
+                "rul_median": None,
+                "rul_p05": None,
+                "rul_p95": None,
+            }
+            continue
+        trend = DegradationTrend(law, healthy)
+        used = [
+            (r["flight"], m)
+            for r in rows
+            if r["flight"] >= onset and (m := _measurement(r, name)) is not None
+        ]
+        trend.update([f for f, _ in used], [m[0] for _, m in used], [m[1] for _, m in used])
+        entry.update(tracked_from=onset, measurements=len(trend))
+        if len(set(trend.t)) < 2:
+            faults[name] = {**entry, "status": "too few measurements", "rul_median": None, "rul_p05": None,
+                            "rul_p95": None}  # fmt: skip
+            continue
+        est = trend.predict_rul(threshold, t_now, SAMPLES, seed + len(estimates))
+        trends[name], estimates[name] = trend, est
+        faults[name] = {**entry, "status": "tracked", **est.to_json(),
+                        "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
+    first: dict[str, Any] = {"status": "no fault tracked"}
+    if estimates:
+        stacked = np.vstack([e.samples for e in estimates.values()])
+        which = np.array(list(estimates))[np.argmin(stacked, axis=0)]
+        est = RulEstimate.from_samples(stacked.min(axis=0), t_now)
+        names, counts = np.unique(which, return_counts=True)
+        first = {
+            "status": "tracked", **est.to_json(),
+            "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4),
+            "most_likely_fault": str(names[np.argmax(counts)]),
+            "placeholder_thresholds": sorted(n for n in estimates if faults[n]["placeholder"]),
+        }  # fmt: skip
+        estimates["first failure"] = est
+    return {
+        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now,
+        "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
+        "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
+    }  # fmt: skip
