@@ -94,7 +94,7 @@ def test_cli_report_and_a_bad_report_path(measured, tmp_path, capsys):
     args = ["identify", "--reference", str(path), "--pop-size", "16", "--generations", "3", "--no-polish"]
     code, _, err = run_cli([*args, "--report", str(tmp_path / "rep")], capsys)
     assert code == 0 and (tmp_path / "rep" / "index.html").is_file() and "wrote the report" in err
-    assert emaphm.report.sha256_of(path) in (tmp_path / "rep" / "index.html").read_text()
+    assert emaphm.io.sha256_of(path) in (tmp_path / "rep" / "index.html").read_text()
     (tmp_path / "afile").write_text("x")
     code, out, err = run_cli([*args, "--report", str(tmp_path / "afile")], capsys)
     assert code == 2 and out == "" and "not a folder" in err and err.count("\n") == 1

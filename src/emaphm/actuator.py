@@ -21,7 +21,6 @@ import dataclasses
 import math
 import os
 import re
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -181,16 +180,9 @@ def _example_unit(si_unit: str) -> str:
 
 def load_params(path: str | os.PathLike[str]) -> EmaParams:
     """Read an actuator file (TOML); `InputError` for a missing, malformed or invalid file."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{p}: no such actuator file")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: cannot read the actuator file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{p}: not a valid TOML file ({exc})") from None
-    return params_from_dict(data, str(p))
+    from .io import read_toml
+
+    return params_from_dict(read_toml(path, "actuator file"), str(path))
 
 
 def resolve_params(params: EmaParams | str | os.PathLike[str] | None) -> EmaParams:
@@ -237,11 +229,12 @@ def params_template(params: EmaParams | None = None) -> str:
 def load_thresholds(path: str | os.PathLike[str]) -> dict[str, float]:
     """The ``[thresholds]`` table of an actuator file: failure thresholds per fault, as distances
     from healthy in fault units (``friction = 0.45``); {} when the file has none."""
+    from .io import read_toml
     from .prognostics.rul import parse_thresholds
 
     p = Path(path)
     load_params(p)  # the whole file is valid
-    data = tomllib.loads(p.read_text(encoding="utf-8")).get("thresholds", {})
+    data = read_toml(p, "actuator file").get("thresholds", {})
     if not isinstance(data, dict):
         raise InputError(f"{p}: [thresholds] must be a table of FAULT = distance from healthy")
     return parse_thresholds(data, where=f"{p}: [thresholds]")

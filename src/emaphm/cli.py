@@ -225,7 +225,8 @@ def identify(
         with atomic_path(output) as tmp:
             tmp.write_text(json.dumps(data, indent=2) + "\n")
     if report is not None:
-        from .report import sha256_of, write_report
+        from .io import sha256_of
+        from .report import write_report
 
         provenance: dict[str, Any] = {
             "reference": str(reference) if reference is not None else "HF twin, noise on",

@@ -17,11 +17,13 @@ allows, like any other tool's.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import signal
 import tempfile
 import threading
+import tomllib
 import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -38,7 +40,9 @@ __all__ = [
     "atomic_path",
     "check_output_path",
     "check_trace_path",
+    "read_toml",
     "read_trace",
+    "sha256_of",
     "side_file",
     "write_trace",
 ]
@@ -283,3 +287,26 @@ def _read_h5(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
                 value = value.item()
             metadata[key] = value
     return columns, metadata
+
+
+def sha256_of(path: str | os.PathLike[str]) -> str:
+    """The SHA-256 of a file (hex), read in 1 MiB blocks: the provenance of an input."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def read_toml(path: str | os.PathLike[str], what: str) -> dict[str, Any]:
+    """A TOML file's content; `InputError` naming `what` (e.g. "actuator file") when it is
+    missing, unreadable or not TOML."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{p}: no such {what}")
+    try:
+        return tomllib.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: cannot read the {what} ({exc})".splitlines()[0]) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{p}: not a valid TOML file ({exc})".splitlines()[0]) from None

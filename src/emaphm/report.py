@@ -13,7 +13,6 @@ previous page or none, never a page that points at missing figures.
 from __future__ import annotations
 
 import base64
-import hashlib
 import html
 import json
 import os
@@ -23,7 +22,7 @@ from typing import Any
 
 from .errors import InputError
 
-__all__ = ["REPORT_FILES", "check_report_dir", "sha256_of", "write_report"]
+__all__ = ["REPORT_FILES", "check_report_dir", "write_report"]
 
 REPORT_FILES = ("fit.png", "faults.png", "convergence.png", "index.html")
 
@@ -39,15 +38,6 @@ def check_report_dir(path: str | os.PathLike[str], *, option: str = "--report") 
     if not os.access(parent, os.W_OK | os.X_OK):
         raise InputError(f"{option} {p}: folder {parent} is not writable")
     return p
-
-
-def sha256_of(path: str | os.PathLike[str]) -> str:
-    """The SHA-256 of a file, in hex."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def write_report(

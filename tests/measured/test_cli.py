@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from emaphm.io import read_trace
-from emaphm.report import sha256_of
+from emaphm.io import sha256_of
 from tests.helpers import run_cli
 from tests.measured.helpers import write_csv
 

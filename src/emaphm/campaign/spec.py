@@ -52,7 +52,6 @@ import json
 import math
 import os
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,6 +61,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..faults import as_fault_vector
+from ..io import read_toml, sha256_of
 
 __all__ = ["CampaignSpec", "Job", "history_seed", "load_campaign"]
 
@@ -82,14 +82,6 @@ MAX_FLIGHTS = 100_000
 def history_seed(seed: int, flight: int) -> int:
     """The identification seed of flight `flight` of a history identified with campaign seed `seed`."""
     return int(np.random.SeedSequence([seed, flight]).generate_state(1)[0])
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with path.open("rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 @dataclass(frozen=True)
@@ -146,7 +138,7 @@ class CampaignSpec:
             if path not in digests:
                 if not path.is_file():
                     raise InputError(f"{self.source}: no such file {path}")
-                digests[path] = _sha256(path)
+                digests[path] = sha256_of(path)
             return digests[path]
 
         out = []
@@ -321,14 +313,7 @@ def load_campaign(path: str | os.PathLike[str]) -> CampaignSpec:
     """Read and validate a campaign file; `InputError` (one line, naming the key) for any mistake."""
     p = Path(path)
     where = str(p)
-    if not p.is_file():
-        raise InputError(f"{p}: no such campaign file")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: cannot read the campaign file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{p}: not a valid TOML file ({exc})") from None
+    data = read_toml(p, "campaign file")
     unknown = sorted(set(data) - TOP_KEYS)
     if unknown:
         raise _fail(

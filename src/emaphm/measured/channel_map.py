@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -108,17 +107,10 @@ class ChannelMap:
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> ChannelMap:
         """Read a TOML channel map; `InputError` for a missing, unreadable or invalid file."""
+        from ..io import read_toml
+
         p = Path(path)
-        if not p.is_file():
-            raise InputError(f"channel map {p}: no such file")
-        try:
-            with p.open("rb") as fh:
-                data = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise InputError(f"channel map {p}: not valid TOML ({exc})".splitlines()[0]) from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"channel map {p}: cannot read it ({exc})".splitlines()[0]) from None
-        return cls.from_dict(data, where=f"channel map {p}")
+        return cls.from_dict(read_toml(p, "channel map"), where=f"channel map {p}")
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], where: str = "channel map") -> ChannelMap:

@@ -10,7 +10,6 @@ channel: `to_reference` splits the record there. Nothing is resampled here.
 
 from __future__ import annotations
 
-import hashlib
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -21,11 +20,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..io import sha256_of
 from .channel_map import ChannelMap
 from .formats import Column, Source, open_source
 from .units import UNIT_TABLE, factor, kind_of
 
-__all__ = ["Channel", "Measurement", "load_measurement", "sha256_of"]
+__all__ = ["Channel", "Measurement", "load_measurement"]
 
 _LISTED = 30  # names listed in a "missing channel" message
 
@@ -111,15 +111,6 @@ class Measurement:
             "channel_map_source": self.channel_map.where,
             "channels": {role: ch.summary() for role, ch in self.channels.items()},
         }
-
-
-def sha256_of(path: Path) -> str:
-    """SHA-256 (hex) of a file, read in 1 MiB blocks."""
-    h = hashlib.sha256()
-    with path.open("rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def load_measurement(
