@@ -21,10 +21,12 @@ The definitions are those of Saxena et al. (IJPHM 2010), the ones ProgPy's metri
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import tomllib
 from pathlib import Path
 
+from emaphm.errors import InputError
 from emaphm.prognostics import rul_report
 
 HERE = Path(__file__).resolve().parent
@@ -48,12 +50,16 @@ def main() -> None:
             j = COLUMN[fault]
             start, growth = act["start"][j], act["growth"][j]
             t_star = 1.0 + (threshold - start) / growth
-            report = rul_report(args.store, act["id"], thresholds=THRESHOLDS)
+            try:
+                report = rul_report(args.store, act["id"], thresholds=THRESHOLDS)
+            except InputError as exc:  # a campaign not run to its end
+                print(f"{act['id']:>8} {fault:>9}  {exc}")
+                continue
             onset = report["faults"][fault].get("tracked_from")
             if onset is None:
                 print(f"{act['id']:>8} {fault:>9} {t_star:6.1f}  never detected")
                 continue
-            last = int(report["at_flight"])
+            last = min(int(report["at_flight"]), math.ceil(t_star) - 1)  # predictions before the end of life
             predictions = {}
             for flight in range(int(onset) + 1, last + 1):
                 f = rul_report(args.store, act["id"], at_flight=flight, thresholds=THRESHOLDS)["faults"][
