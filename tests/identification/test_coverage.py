@@ -83,7 +83,8 @@ def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_
 
 def test_the_twin_on_the_fdi_chirp_raises_no_warning():
     r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=16, generations=3, local_polish=False)
-    assert r.verdict == "fits" and r.warnings == []
+    # this 16 x 3 budget fits poorly (about 30 % NRMSE) and says so; nothing else may be said
+    assert r.verdict == "fits" and [w for w in r.warnings if not w.startswith("the fit is poor")] == []
 
 
 def test_a_chirp_with_a_hold_is_covered_and_its_held_samples_are_left_out():
