@@ -215,7 +215,11 @@ def test_dask_runs_the_same_jobs_on_one_numba_thread_per_worker(tmp_path):
     pytest.importorskip("distributed")
     spec = write_spec(tmp_path)
     serial = run_campaign(spec, tmp_path / "serial", workers=1)
+    before = dict(os.environ)
     dask = run_campaign(spec, tmp_path / "dask", workers=2)
+    # Dask's nannies put NUMBA_NUM_THREADS=1 into this process's environment to hand it to the
+    # workers; left there, the next numba compile here failed (every later test, on a cold cache)
+    assert dict(os.environ) == before
     assert serial.done == dask.done == 12 and "dask" in dask.backend
     a = {r["job_key"]: r for r in ResultStore(tmp_path / "serial").read().to_pylist()}
     b = {r["job_key"]: r for r in ResultStore(tmp_path / "dask").read().to_pylist()}

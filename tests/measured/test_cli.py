@@ -7,8 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from emaphm.io import read_trace
-from emaphm.io import sha256_of
+from emaphm.io import read_trace, sha256_of
 from tests.helpers import run_cli
 from tests.measured.helpers import write_csv
 

@@ -165,6 +165,7 @@ def _run_dask(
     from distributed import Client, LocalCluster, as_completed
 
     cluster = None
+    environ = dict(os.environ)  # Dask's nannies write their pre-spawn variables into ours: put back
     if address is None:
         _warm_up()
         # one numba thread per worker (numba ignores the OMP_NUM_THREADS=1 Dask sets), and no
@@ -190,7 +191,13 @@ def _run_dask(
         workers = max(1, len(client.scheduler_info().get("workers", {})))
         backend = f"dask scheduler {address} ({workers} workers)"
     if cluster is not None:
-        client.wait_for_workers(workers)
+        try:
+            client.wait_for_workers(workers)
+        finally:
+            # the nannies set NUMBA_NUM_THREADS=1 (and OMP_*, PYTHONHASHSEED) in this process's
+            # environment to pass them to the workers; left there, numba's next compile here
+            # re-reads it and fails against the thread pool it launched with another count
+            _restore_environ(environ)
     # each worker imports emaphm and loads the compiled kernels before the first job (2-3 s a
     # process), so that jobs are timed and balanced on warm workers
     client.run(_warm_up)
@@ -216,7 +223,17 @@ def _run_dask(
         client.close()
         if cluster is not None:
             cluster.close()
+        _restore_environ(environ)
     return backend, workers
+
+
+def _restore_environ(saved: dict[str, str]) -> None:
+    """Make `os.environ` what it was (`saved`)."""
+    for key in set(os.environ) - set(saved):
+        del os.environ[key]
+    for key, value in saved.items():
+        if os.environ.get(key) != value:
+            os.environ[key] = value
 
 
 def campaign_status(
