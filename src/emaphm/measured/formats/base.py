@@ -90,3 +90,30 @@ class Source(ABC):
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class TreeSource(Source):
+    """A file of named variables reached by ``/`` paths (HDF5, MATLAB): `has` and `read` from
+    `_resolve` (the variable of a path, or None) and `_column` (a resolved variable's `Column`)."""
+
+    thing = "variable"  # the word in "no <thing> 'name'"
+
+    @abstractmethod
+    def _resolve(self, name: str) -> Any:
+        """The variable at path `name`, or None."""
+
+    @abstractmethod
+    def _column(self, name: str, found: Any, where: str) -> Column:
+        """The `Column` of a resolved variable; `where` names it in messages."""
+
+    def has(self, name: str) -> bool:
+        return self._resolve(name) is not None
+
+    def read(self, names: Sequence[str]) -> dict[str, Column]:
+        out = {}
+        for name in names:
+            found = self._resolve(name)
+            if found is None:
+                raise InputError(f"{self.path}: no {self.thing} {name!r}")
+            out[name] = self._column(name, found, f"{self.path}: {name!r}")
+        return out

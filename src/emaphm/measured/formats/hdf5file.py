@@ -10,13 +10,12 @@ with ``-v7`` or as plain vectors. A dataset's ``unit``/``units`` attribute is re
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from ...errors import InputError
 from ..limits import MAX_SAMPLES
-from .base import Column, Source, as_vector
+from .base import Column, TreeSource, as_vector
 
 __all__ = ["Hdf5Source"]
 
@@ -31,8 +30,10 @@ def _text(value: Any) -> str | None:
     return None
 
 
-class Hdf5Source(Source):
+class Hdf5Source(TreeSource):
     """HDF5 or MATLAB v7.3 (see the module docstring); the file stays open until `close`."""
+
+    thing = "dataset"
 
     def __init__(self, path: Path, fmt: str = "hdf5") -> None:
         import h5py
@@ -99,32 +100,21 @@ class Hdf5Source(Source):
                 return obj
         return None
 
-    def has(self, name: str) -> bool:
-        return self._resolve(name) is not None
-
-    def read(self, names: Sequence[str]) -> dict[str, Column]:
-        out = {}
-        for name in names:
-            ds = self._resolve(name)
-            if ds is None:
-                raise InputError(f"{self.path}: no dataset {name!r}")
-            where = f"{self.path}: {name!r}"
-            if self._matlab_class(ds) == "char":
-                raise InputError(f"{where} is MATLAB text, not numbers")
-            if ds.size > MAX_SAMPLES:  # refused before the data are read
-                raise InputError(
-                    f"{where} has {ds.size:.3g} samples, more than {MAX_SAMPLES:.0e}: split the record"
-                )
-            try:
-                raw = ds[()]
-            except Exception as exc:  # truncated data: the header opened, the chunks are gone
-                raise InputError(
-                    f"{self.path}: cannot read {name!r} ({_reason(exc)}): truncated or corrupt file"
-                ) from None
-            values = as_vector(raw, where)
-            unit = _text(ds.attrs.get("unit", ds.attrs.get("units")))
-            out[name] = Column(values=values, unit=unit or None)
-        return out
+    def _column(self, name: str, ds: Any, where: str) -> Column:
+        if self._matlab_class(ds) == "char":
+            raise InputError(f"{where} is MATLAB text, not numbers")
+        if ds.size > MAX_SAMPLES:  # refused before the data are read
+            raise InputError(
+                f"{where} has {ds.size:.3g} samples, more than {MAX_SAMPLES:.0e}: split the record"
+            )
+        try:
+            raw = ds[()]
+        except Exception as exc:  # truncated data: the header opened, the chunks are gone
+            raise InputError(
+                f"{self.path}: cannot read {name!r} ({_reason(exc)}): truncated or corrupt file"
+            ) from None
+        unit = _text(ds.attrs.get("unit", ds.attrs.get("units")))
+        return Column(values=as_vector(raw, where), unit=unit or None)
 
 
 def _reason(exc: BaseException) -> str:

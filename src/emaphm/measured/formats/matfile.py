@@ -12,14 +12,13 @@ element with a ``Raster`` takes its time from the element of a sibling struct ar
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ...errors import InputError
-from .base import Column, Source, as_vector
+from .base import Column, TreeSource, as_vector
 
 __all__ = ["MatSource"]
 
@@ -38,7 +37,7 @@ def _as_list(node: Any) -> Any:
     return [node] if isinstance(node, dict) and "Name" in node and "Data" in node else node
 
 
-class MatSource(Source):
+class MatSource(TreeSource):
     """A MATLAB v4/v5/v7 file, loaded whole (scipy reads no part of a v5 file alone)."""
 
     def __init__(self, path: Path, fmt: str = "mat-v5") -> None:
@@ -120,31 +119,20 @@ class MatSource(Source):
                     return node, None, parent
         return None
 
-    def has(self, name: str) -> bool:
-        return self._resolve(name) is not None
-
-    def read(self, names: Sequence[str]) -> dict[str, Column]:
-        out = {}
-        for name in names:
-            found = self._resolve(name)
-            if found is None:
-                raise InputError(f"{self.path}: no variable {name!r}")
-            value, element, parent = found
-            where = f"{self.path}: {name!r}"
-            column = Column(values=as_vector(value, where))
-            if element is not None:
-                unit = element.get("Unit")
-                raster = element.get("Raster")
-                time, time_unit = (None, None)
-                if isinstance(raster, str) and raster and isinstance(parent, dict):
-                    time, time_unit = self._raster(parent, raster, element, where)
-                column = Column(
-                    values=column.values, time=time, time_unit=time_unit,
-                    raster=raster if time is not None else None,
-                    unit=unit if isinstance(unit, str) and unit else None,
-                )  # fmt: skip
-            out[name] = column
-        return out
+    def _column(self, name: str, found: Any, where: str) -> Column:
+        value, element, parent = found
+        column = Column(values=as_vector(value, where))
+        if element is None:
+            return column
+        unit = element.get("Unit")
+        raster = element.get("Raster")
+        time, time_unit = (None, None)
+        if isinstance(raster, str) and raster and isinstance(parent, dict):
+            time, time_unit = self._raster(parent, raster, element, where)
+        return Column(
+            values=column.values, time=time, time_unit=time_unit, raster=raster if time is not None else None,
+            unit=unit if isinstance(unit, str) and unit else None,
+        )  # fmt: skip
 
     def _raster(
         self, parent: dict[str, Any], raster: str, element: dict[str, Any], where: str
