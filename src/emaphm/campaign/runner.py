@@ -177,6 +177,7 @@ def _run_dask(
             # the event loop's housekeeping wakes less often (it takes the GIL from the job)
             "distributed.admin.tick.interval": "500ms",
             "distributed.admin.system-monitor.interval": "2s",
+            "distributed.worker.memory.monitor-interval": "1s",
         }):  # fmt: skip
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
