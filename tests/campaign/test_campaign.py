@@ -228,3 +228,19 @@ def test_dask_runs_the_same_jobs_on_one_numba_thread_per_worker(tmp_path):
         assert [a[key][f"k{i}"] for i in range(1, 9)] == [b[key][f"k{i}"] for i in range(1, 9)]
     assert {r["numba_threads"] for r in b.values()} == {1}  # workers x threads within the cores
     assert len({r["worker"] for r in b.values()}) == 2
+
+
+def test_a_store_written_before_a_column_existed_still_reads(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    old = tmp_path / "results" / "campaign=c" / "actuator=007"
+    old.mkdir(parents=True)
+    pq.write_table(pa.table({"job_key": ["k-old"], "flight": [1], "k1": [0.2]}), old / "part-old.parquet")
+    ResultStore(tmp_path).write("results", [{"job_key": "k-new", "campaign": "c", "actuator": "007", "flight": 2,
+                                             "uq_flags": "[]"}])  # fmt: skip
+    rows = {r["job_key"]: r for r in ResultStore(tmp_path).read().to_pylist()}
+    assert (
+        rows["k-old"]["uq_flags"] is None and rows["k-old"]["k1"] == 0.2 and rows["k-new"]["uq_flags"] == "[]"
+    )
+    assert rows["k-old"]["actuator"] == "007"

@@ -123,8 +123,12 @@ class ResultStore:
             types = {**base, "campaign": "string", "actuator": "string"}
             return pa.table({n: pa.array([], type=getattr(pa, types[n])()) for n in names})
         partitioning = ds.partitioning(pa.schema([(p, pa.string()) for p in PARTITIONS]), flavor="hive")
+        # the full schema: a part file written before a column existed reads with nulls there
+        schema = pa.schema(
+            [(n, getattr(pa, t)()) for n, t in base.items()] + [(p, pa.string()) for p in PARTITIONS]
+        )
         try:
-            data = ds.dataset(folder, format="parquet", partitioning=partitioning)
+            data = ds.dataset(folder, format="parquet", partitioning=partitioning, schema=schema)
             filt = (ds.field("campaign") == campaign) if campaign is not None else None
             return data.to_table(columns=names, filter=filt)
         except (pa.ArrowInvalid, OSError) as exc:
