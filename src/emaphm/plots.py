@@ -73,31 +73,22 @@ def plot_calibration(
 def plot_fit(
     t: np.ndarray, measured: np.ndarray, identified: np.ndarray, path: Path, f_s: float = 1e4
 ) -> Path:
-    """Measured vs identified current (both filtered) and their residual."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
-    m, i = lowpass(measured, f_s), lowpass(identified, f_s)
-    ax[0].plot(t, measured, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
-    ax[0].plot(t, m, "k", lw=1.0, label="measured, filtered")
-    ax[0].plot(t, i, "C1", lw=1.0, label="LF model with the identified faults")
-    ax[0].set_ylabel("current [A]")
-    ax[0].legend(loc="upper right", fontsize=8)
-    ax[1].plot(t, m - i, "C3", lw=0.8)
-    ax[1].set_ylabel("residual [A]")
-    ax[1].set_xlabel("time [s]")
-    for a in ax:
-        a.grid(alpha=0.3)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    """Measured (raw and filtered) vs identified current (filtered) and their residual."""
+    curves = {"t": t, "measured": lowpass(measured, f_s), "fitted": lowpass(identified, f_s)}
+    return plot_fit_curves(curves, path, raw=measured)
 
 
-def plot_fit_curves(curves: Mapping[str, np.ndarray], path: Path, title: str = "") -> Path:
+def plot_fit_curves(
+    curves: Mapping[str, np.ndarray], path: Path, title: str = "", raw: np.ndarray | None = None
+) -> Path:
     """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the LF
-    current at the estimate and their residual; samples the fitness left out (a hold) shaded."""
+    current at the estimate and their residual; samples the fitness left out (a hold) shaded, and
+    the unfiltered measurement `raw` behind when given."""
     plt = _pyplot()
     t, m, f = curves["t"], curves["measured"], curves["fitted"]
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
+    if raw is not None:
+        ax[0].plot(t, raw, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
     ax[0].plot(t, m, "k", lw=1.0, label="measured $i_q$, filtered")
     ax[0].plot(t, f, "C1", lw=1.0, label="LF model at the identified faults")
     ax[0].set_ylabel("current [A]")

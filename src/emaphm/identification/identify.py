@@ -28,6 +28,7 @@ from ..errors import InputError, SimulationError
 from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
 from ..measured.checks import plausibility
+from ..measured.limits import MAX_SPAN, MIN_DURATION
 from ..models import HighFidelityEma, MonitorEma, check_seed
 from ..params import EmaParams
 from ..results import SimResult
@@ -64,11 +65,10 @@ MIN_COMPARED = 0.3
 # a diagnosis needs this much of the FDI command: on the Table 1 case (benchmarks, noise seed 7)
 # the first 0.1 s gave 31.7 %err (friction missed, a spurious eccentricity) while fitting to 3.9 %
 # NRMSE, 0.2 s 5.4 %err, 0.3 s and 0.5 s 3.4 %err
-MIN_SPAN = 0.2
+MIN_SPAN = MIN_DURATION  # 0.2 s, the reader's shortest clean segment too (measured.limits)
 # the comparison spans at most this: 100 s is 1e6 samples per row (the fused fitness kernel keeps
 # two rows per thread; the reference, its weights and the grid are a few times that), and a longer
-# span is more often a time axis in ms than a real recording
-MAX_SPAN = 100.0
+# span is more often a time axis in ms than a real recording; the reader refuses the same (measured.limits)
 # a fit whose LF current leaves more than half of the filtered measurement unexplained (NRMSE) is
 # not a diagnosis. Measured: default-budget fits 2.5-3 % (Table 1, the worst random benchmark
 # case), a 16 x 3 budget without polish 28-34 %; a current in mA 99.8 %, a flipped sign 150 %, a
@@ -590,32 +590,20 @@ def identify(
         "workers": workers,
         "optimizer_wall_time_s": round(ident.wall_time_, 3),
         "calibration": {
-            "source": "packaged"
-            if calibration is None
-            else str(calibration)
-            if not isinstance(calibration, Calibration)
-            else "Calibration object",
+            "source": _source(calibration, "packaged", Calibration),
             "created": monitor_model.calibration.record.get("created"),
             "params_hash": monitor_model.calibration.params_hash,
             "monitor": monitor_model.monitor,
         },
         "params": {
-            "source": "nominal"
-            if params is None
-            else str(params)
-            if not isinstance(params, EmaParams)
-            else "EmaParams object",
+            "source": _source(params, "nominal", EmaParams),
             "params_hash": params_hash(actuator),
         },
         "uncertainty": uncertainty,
         "uq_calibration": None
         if factors is None
         else {
-            "source": "packaged"
-            if uq_calibration is None
-            else str(uq_calibration)
-            if not isinstance(uq_calibration, Factors)
-            else "Factors object",
+            "source": _source(uq_calibration, "packaged", Factors),
             "created": factors.record.get("created"),
             "calibrated": bool(factors.record),
         },
@@ -627,3 +615,10 @@ def identify(
         detected=detected, history=run.history, settings=settings, warnings=warnings,
         fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged, curves=ident.curves(),
     )  # fmt: skip
+
+
+def _source(value: Any, default: str, kind: type) -> str:
+    """How an input was given, for the record: `default` when not given, its path, or an object."""
+    if value is None:
+        return default
+    return f"{kind.__name__} object" if isinstance(value, kind) else str(value)
