@@ -1,7 +1,7 @@
 """Prognostics on simulated run-to-failure histories (issue 12): alpha-lambda, coverage, horizon.
 
     emaphm campaign run benchmarks/campaigns/rtf.toml --out STORE      # 285 identifications
-    python benchmarks/bench_rul.py STORE [--alpha 0.2] [--lam 0.5]
+    python benchmarks/bench_rul.py STORE [--alpha 0.2] [--lam 0.5] [--estimator trend|ukf]
 
 The campaign flies 10 actuators on the HF twin (noise on) whose friction and backlash grow
 linearly from flight 1 (start 0.05 and 0.02, growth drawn per actuator, `rtf.toml`); every flight
@@ -15,7 +15,12 @@ first detection):
   accuracy 1 - |RUL - true|/true;
 - the prognostic horizon: T* minus the first flight from which every later prediction stays
   within alpha*(T* - onset) of the truth, as a fraction of the life T* - onset.
-The definitions are those of Saxena et al. (IJPHM 2010), the ones ProgPy's metrics implement.
+The definitions are those of Saxena et al. (IJPHM 2010). Where ProgPy is installed
+(``emaphm[progpy]``), ProgPy's own metrics are computed too on the same predictions (a
+``ToEPredictionProfile`` of every prediction's draws): its α-λ (at least beta = 50 % of the
+draws within alpha of the true RUL, at the first prediction at or after lambda), its prognostic
+horizon (with the criterion "the median within alpha of the life", as a fraction of the life) and
+its cumulative relative accuracy (of the time of event, as ProgPy defines it).
 """
 
 from __future__ import annotations
@@ -40,7 +45,13 @@ def main() -> None:
     parser.add_argument("--spec", type=Path, default=HERE / "campaigns" / "rtf.toml")
     parser.add_argument("--alpha", type=float, default=0.2)
     parser.add_argument("--lam", type=float, default=0.5)
+    parser.add_argument("--estimator", default="trend", choices=("trend", "ukf"))
     args = parser.parse_args()
+    try:
+        from emaphm.prognostics import progpy_model
+    except InputError:
+        progpy_model = None  # type: ignore[assignment]
+    pp_met, pp_ph, pp_cra = 0, [], []
     spec = tomllib.loads(args.spec.read_text())
     met, covered, accuracy, horizons, n = 0, 0, [], [], 0
     print(f"{'actuator':>8} {'fault':>9} {'T*':>6} {'onset':>5} {'at':>4} {'true':>6} {'median':>6} "
@@ -51,7 +62,7 @@ def main() -> None:
             start, growth = act["start"][j], act["growth"][j]
             t_star = 1.0 + (threshold - start) / growth
             try:
-                report = rul_report(args.store, act["id"], thresholds=THRESHOLDS)
+                report = rul_report(args.store, act["id"], thresholds=THRESHOLDS, estimator=args.estimator)
             except InputError as exc:  # a campaign not run to its end
                 print(f"{act['id']:>8} {fault:>9}  {exc}")
                 continue
@@ -60,13 +71,15 @@ def main() -> None:
                 print(f"{act['id']:>8} {fault:>9} {t_star:6.1f}  never detected")
                 continue
             last = min(int(report["at_flight"]), math.ceil(t_star) - 1)  # predictions before the end of life
-            predictions = {}
+            predictions, draws = {}, {}
             for flight in range(int(onset) + 1, last + 1):
-                f = rul_report(args.store, act["id"], at_flight=flight, thresholds=THRESHOLDS)["faults"][
-                    fault
-                ]
+                r = rul_report(
+                    args.store, act["id"], at_flight=flight, thresholds=THRESHOLDS, estimator=args.estimator
+                )
+                f = r["faults"][fault]
                 if f.get("rul_median") is not None:
                     predictions[flight] = f
+                    draws[flight] = {fault: flight + r["_estimates"][fault].samples}
             at = round(onset + args.lam * (t_star - onset))
             if at not in predictions:
                 print(f"{act['id']:>8} {fault:>9} {t_star:6.1f} {onset:>5}  no prediction at flight {at}")
@@ -87,6 +100,15 @@ def main() -> None:
                                                                    if g in predictions)), None)  # fmt: skip
             ph = 0.0 if first is None else (t_star - first) / (t_star - onset)
             horizons.append(ph)
+            if progpy_model is not None:
+                profile = progpy_model.toe_profile(draws, never=10 * t_star)
+                m = progpy_model.progpy_metrics(profile, {fault: t_star}, lambda_value=at, alpha=args.alpha,
+                                                onset=onset)[fault]  # fmt: skip
+                pp_met += m["alpha_lambda"]
+                pp_ph.append(
+                    0.0 if m["prognostic_horizon"] is None else m["prognostic_horizon"] / (t_star - onset)
+                )
+                pp_cra.append(m["cra"])
             print(f"{act['id']:>8} {fault:>9} {t_star:6.1f} {onset:>5} {at:>4} {true:6.1f} {p['rul_median']:6.1f} "
                   f"{p['rul_p05']:6.1f}-{p['rul_p95']:6.1f} {'yes' if ok else 'no':>4} {ph:7.2f}")  # fmt: skip
     print()
@@ -97,6 +119,13 @@ def main() -> None:
         print(f"relative accuracy at lambda: median {statistics.median(accuracy):.3f}, min {min(accuracy):.3f}; "
               f"prognostic horizon (fraction of life): median {statistics.median(horizons):.2f}, "
               f"min {min(horizons):.2f}")  # fmt: skip
+    if progpy_model is not None and pp_cra:
+        print(f"ProgPy's metrics: alpha-lambda (beta 0.5) met {pp_met} of {len(pp_cra)}; prognostic horizon "
+              f"(fraction of life) median {statistics.median(pp_ph):.2f}, min {min(pp_ph):.2f}; cumulative "
+              f"relative accuracy median {statistics.median(pp_cra):.3f}, min {min(pp_cra):.3f}")  # fmt: skip
+    elif progpy_model is None:
+        print("ProgPy's metrics: not computed (pip install 'emaphm[progpy]')")
+    print(f"estimator: {args.estimator}")
 
 
 if __name__ == "__main__":

@@ -577,6 +577,95 @@ def _print_params(actuator: Any, source: str) -> None:
 
 
 @app.command()
+def thresholds(
+    require: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="A requirement KIND=LIMIT (repeatable): tracking=0.5deg (max |θ_u − θ_cmd|), "
+            "tracking_rms=0.2deg, current=I_max (or 0.9I_max, 8A: the current demand), free_play=1.5mrad "
+            "(total at the surface). A bare number is SI."
+        ),
+    ] = None,
+    params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
+    command: Annotated[str, typer.Option(help=f"Reference command: {', '.join(COMMAND_NAMES)}.")] = "chirp",
+    fault: Annotated[
+        list[str] | None, typer.Option(help="Derive only this fault (repeatable); default: all.")
+    ] = None,
+    resolution: Annotated[
+        float, typer.Option(help="Width of the final bisection interval, in fault units.")
+    ] = 0.005,
+    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Write the [thresholds] table (TOML) here, to paste into the actuator file.",
+        ),
+    ] = None,
+) -> None:
+    """Failure thresholds per fault from the HF twin and requirements: the smallest distance from healthy that breaks one."""
+    import json
+
+    from .actuator import resolve_params
+    from .io import atomic_path, check_output_path
+    from .prognostics.thresholds import derive_thresholds, parse_requirement, thresholds_toml
+
+    if not require:
+        raise InputError(
+            "give at least one --require KIND=LIMIT, e.g. --require tracking=1.6deg --require current=I_max"
+        )
+    if output is not None:
+        check_output_path(output, suffixes=(".toml",), inputs=(params,))
+    actuator = resolve_params(params)
+    requirements = [parse_requirement(text, params=actuator) for text in require]
+    with _progress() as update:
+        result = derive_thresholds(
+            requirements, params=actuator, command=command, faults=fault, resolution=resolution,
+            progress=lambda done, total: update("HF simulations", done, total),
+        )  # fmt: skip
+    for warning in result["warnings"]:
+        err.print(f"emaphm: warning: {warning}", soft_wrap=True, markup=False)
+    if output is not None:
+        with atomic_path(output) as tmp:
+            tmp.write_text(thresholds_toml(result), encoding="utf-8")
+        err.print(f"wrote {output}: paste its [thresholds] table into the actuator file", markup=False)
+    if json_out:
+        typer.echo(json.dumps(result))
+        return
+    _print_thresholds(result, str(params) if params is not None else "the nominal actuator")
+
+
+def _print_thresholds(data: dict[str, Any], source: str) -> None:
+    from rich.table import Table
+
+    reqs = {r["kind"]: r for r in data["requirements"]}
+
+    def show(kind: str, value: float) -> str:
+        return f"{value / reqs[kind]['scale']:.4g} {reqs[kind]['unit']}"
+
+    table = Table(title=f"failure thresholds of {source}, {data['command']['type']} command")
+    for column in ("fault", "threshold", "limited by", "at threshold", "worst case", "status"):
+        table.add_column(column, justify="right" if column in ("threshold", "at threshold") else "left")
+    for name, f in data["faults"].items():
+        if f["threshold"] is None:
+            table.add_row(
+                name, "none", "-", "-", "-", f"{f['status']} (rul: placeholder {f['rul_placeholder']:g})"
+            )
+            continue
+        kind = f["limited_by"]
+        table.add_row(name, f"{f['threshold']:.4g}", kind, show(kind, f["at_threshold"][kind]),
+                      f["case"] or "-", f["status"])  # fmt: skip
+    out = _stdout_console()
+    out.print(table)
+    out.print("requirements: " + ", ".join(f"{r['kind']} < {r['text']}" for r in data["requirements"]))
+    out.print("healthy: " + ", ".join(f"{kind} {show(kind, v)}" for kind, v in data["healthy"].items()))
+    out.print(
+        f"{data['simulations']} HF simulations (noise off), {data['wall_time_s']:.1f} s; actuator {data['params_hash']}"
+    )
+
+
+@app.command()
 def rul(
     store: Annotated[
         Path, typer.Argument(help="Folder of a campaign's results store (emaphm campaign run --out).")
@@ -601,6 +690,13 @@ def rul(
     inspection_interval: Annotated[
         float, typer.Option(help="Flights to the next inspection, for the probability of failing before it.")
     ] = 10.0,
+    estimator: Annotated[
+        str,
+        typer.Option(
+            help="trend: weighted regression per fault (no dependency); ukf: ProgPy's unscented "
+            "Kalman filter (pip install 'emaphm[progpy]')."
+        ),
+    ] = "trend",
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write the prognosis figure here (.png).")] = None,
 ) -> None:
@@ -621,7 +717,7 @@ def rul(
         given.update(load_thresholds(params))
     given.update(parse_thresholds(threshold))
     report = rul_report(store, actuator, campaign=campaign, at_flight=at_flight, thresholds=given,
-                        inspection_interval=inspection_interval)  # fmt: skip
+                        inspection_interval=inspection_interval, estimator=estimator)  # fmt: skip
     data = {k: v for k, v in report.items() if not k.startswith("_")}
     if plot is not None:
         from .plots import plot_rul
@@ -642,6 +738,7 @@ def _print_rul(data: dict[str, Any]) -> None:
 
     table = Table(
         title=f"actuator {data['actuator']} ({data['campaign']}), as of flight {data['at_flight']:g}"
+        + (" (ProgPy UKF)" if data.get("estimator") == "ukf" else "")
     )
     for column in (
         "fault",

@@ -4,23 +4,36 @@
   variance (MATLAB-like ``update`` / ``restart`` / ``predict_rul``), and `RulEstimate`;
 - `rul`: `rul_report`, the RUL of each tracked fault and of the first failure of an actuator of a
   campaign store (`emaphm.campaign`), with the failure thresholds and their status;
-- `metrics`: α-λ, the prognostic horizon and the relative accuracy of a sequence of predictions
-  against the true end of life (validation, BENCHMARKS.md).
+- `thresholds`: `derive_thresholds`, the failure threshold of each fault from the HF twin and
+  requirements (`Requirement`, `parse_requirement`: tracking error, current demand, free play),
+  and `thresholds_toml`, the ``[thresholds]`` table of the actuator file;
+- `progpy_model` (the optional ``progpy`` extra; imported only when asked for): the fault-growth
+  laws as a ProgPy ``PrognosticsModel`` (`FaultGrowth`), tracked by ProgPy's UKF with each
+  identification's own variance (``emaphm rul --estimator ukf``), ProgPy's MonteCarlo predictor
+  as a check of the closed-form crossing, and ProgPy's metrics (α-λ, prognostic horizon,
+  cumulative relative accuracy) of a sequence of predictions.
 
-``emaphm rul STORE --actuator ID`` is the command line; docs/prognostics.md the guide.
+``emaphm rul STORE --actuator ID`` and ``emaphm thresholds --require KIND=LIMIT`` are the command
+lines; docs/prognostics.md the guide.
 """
 
 from __future__ import annotations
 
 from .rul import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds, rul_report
+from .thresholds import REQUIREMENT_KINDS, Requirement, derive_thresholds, parse_requirement, thresholds_toml
 from .trend import LAWS, DegradationTrend, RulEstimate
 
 __all__ = [
     "FAULTS",
     "LAWS",
     "PLACEHOLDER_THRESHOLDS",
+    "REQUIREMENT_KINDS",
     "DegradationTrend",
+    "Requirement",
     "RulEstimate",
+    "derive_thresholds",
+    "parse_requirement",
     "parse_thresholds",
     "rul_report",
+    "thresholds_toml",
 ]

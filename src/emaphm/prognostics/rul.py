@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import InputError
 from .trend import DegradationTrend, RulEstimate
 
-__all__ = ["FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "rul_report"]
+__all__ = ["ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "rul_report"]
 
 # tracked faults: name -> (column, law, healthy value); k7 (a direction) is not a damage
 FAULTS: dict[str, tuple[str, str, float]] = {
@@ -45,6 +45,7 @@ PLACEHOLDER_THRESHOLDS: dict[str, float] = {
     "eccentricity": 0.3, "kp_drift": 0.3,
 }  # fmt: skip
 SAMPLES = 4000
+ESTIMATORS = ("trend", "ukf")
 
 
 def parse_thresholds(
@@ -129,10 +130,15 @@ def rul_report(
     thresholds: dict[str, float] | None = None,
     inspection_interval: float = 10.0,
     seed: int = 0,
+    estimator: str = "trend",
 ) -> dict[str, Any]:
     """The RUL of each tracked fault and of the first failure, as of flight `at_flight` (default:
-    the last one stored), JSON-ready; see the module docstring. ``_trends`` and ``_estimates``
-    (not JSON) hold the fitted trends and the draws, for a plot."""
+    the last one stored), JSON-ready; see the module docstring. `estimator`: "trend"
+    (`DegradationTrend`, no dependency) or "ukf" (ProgPy's unscented Kalman filter on the
+    `progpy_model.FaultGrowth` model; the ``progpy`` extra). ``_trends`` and ``_estimates`` (not
+    JSON) hold the fitted trends and the draws, for a plot."""
+    if estimator not in ESTIMATORS:
+        raise InputError(f"unknown estimator {estimator!r}; use one of {', '.join(ESTIMATORS)}")
     rows = history(store, actuator, campaign)
     if at_flight is not None:
         rows = [r for r in rows if r["flight"] <= at_flight]
@@ -168,7 +174,13 @@ def rul_report(
             faults[name] = {**entry, "status": "too few measurements", "rul_median": None, "rul_p05": None,
                             "rul_p95": None}  # fmt: skip
             continue
-        est = trend.predict_rul(threshold, t_now, SAMPLES, seed + len(estimates))
+        if estimator == "ukf":
+            from . import progpy_model
+
+            model, ukf = progpy_model.track(name, law, threshold, trend.t, trend.k, trend.sd)
+            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, seed + len(estimates))
+        else:
+            est = trend.predict_rul(threshold, t_now, SAMPLES, seed + len(estimates))
         trends[name], estimates[name] = trend, est
         faults[name] = {**entry, "status": "tracked", **est.to_json(),
                         "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
@@ -186,7 +198,7 @@ def rul_report(
         }  # fmt: skip
         estimates["first failure"] = est
     return {
-        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now,
+        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
         "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
         "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
     }  # fmt: skip
