@@ -16,6 +16,7 @@ import pytest
 import emaphm
 from emaphm.campaign import ResultStore, campaign_status, history_seed, load_campaign, run_campaign
 from emaphm.errors import InputError
+from emaphm.faults import random_faults
 from tests.helpers import run_cli
 
 # a budget that makes a job ~0.1 s: the plumbing is tested here, not the accuracy
@@ -69,6 +70,40 @@ def test_a_history_expands_to_one_job_per_flight_and_seed(tmp_path):
     assert len({j.identify_seed for j in h1}) == 4 and h1[2].identify_seed == history_seed(1, 3)
 
 
+def test_a_fleet_expands_reproducibly_into_drawn_actuators(tmp_path):
+    # 1 000 jobs from a file of 18 lines: 200 random actuators and 40 drawn histories of 20 flights
+    text = (
+        '[campaign]\nname = "fleet"\nseeds = [1]\n\n[[fleet]]\nprefix = "R"\ncount = 200\nseed = 7\n'
+        'faults = "random"\nabsent = 0.3\n\n[[fleet]]\nprefix = "H"\ncount = 40\nseed = 8\nflights = 20\n'
+        "start  = [0.05, 0.02, 0, 0, 0, 0, 0, 0.5]\ngrowth = [[0.01, 0.02], [0.004, 0.009], 0, 0, 0, 0, 0, 0]\n"
+    )
+    (tmp_path / "f.toml").write_text(text)
+    assert text.count("\n") == 18  # <= 20
+    spec = load_campaign(tmp_path / "f.toml")
+    jobs = spec.jobs()
+    assert len(jobs) == 1000 and len({j.key for j in jobs}) == 1000
+    assert [a.id for a in spec.actuators][:2] == ["R000", "R001"] and spec.actuators[200].id == "H00"
+    random = np.array([a.truths[0] for a in spec.actuators[:200]])
+    np.testing.assert_array_equal(random, random_faults(200, 7, absent=0.3))  # the documented draw
+    histories = [a for a in spec.actuators if a.kind == "history"]
+    growth = np.array([np.subtract(a.truths[1], a.truths[0]) for a in histories])
+    assert (
+        np.all((growth[:, 0] >= 0.01 - 1e-12) & (growth[:, 0] <= 0.02 + 1e-12))
+        and np.ptp(growth[:, 0]) > 0.005
+    )
+    assert np.all(growth[:, 2:] == 0)  # the other faults hold their start
+    # the same file is the same fleet: the same keys
+    assert [j.key for j in jobs] == [j.key for j in load_campaign(tmp_path / "f.toml").jobs()]
+    (tmp_path / "g.toml").write_text(text.replace("seed = 8", "seed = 9"))
+    # flight 1 is the common start (the same job, the same key); every later flight is drawn anew
+    other = {
+        j.key
+        for j in load_campaign(tmp_path / "g.toml").jobs()
+        if j.actuator.startswith("H") and j.flight > 1
+    }
+    assert len(other) == 40 * 19 and not other & {j.key for j in jobs}
+
+
 def test_job_keys_are_content_keys(tmp_path):
     keys = [j.key for j in load_campaign(write_spec(tmp_path)).jobs()]
     assert keys == [j.key for j in load_campaign(write_spec(tmp_path)).jobs()]  # stable
@@ -106,6 +141,18 @@ def test_job_keys_are_content_keys(tmp_path):
         ('[campaign]\nname = "x"\n[identify]\noptimizer = "sa"\n[[actuator]]\nid = "a"\n'
          'faults = [0,0,0,0,0,0,0,0.5]', "optimizer"),
         ('[campaign]\nname = "x"\n', "no \\[\\[actuator\\]\\]"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 0\nseed = 1\nfaults = "random"', "count must be"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nfaults = "random"', "seed must be"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nseed = 1\nfaults = "random"\nflights = 2',
+         "exactly one of"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nseed = 1\nfaults = [[0, 2],0,0,0,0,0,0,0.5]',
+         "faults"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nseed = 1\nfaults = [[0.3, 0.1],0,0,0,0,0,0,0.5]',
+         "low <= high"),
+        ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nseed = 1\nfaults = "random"\nsize = 2',
+         "unknown key"),
+        ('[campaign]\nname = "x"\n[[actuator]]\nid = "R1"\nfaults = [0,0,0,0,0,0,0,0.5]\n[[fleet]]\nprefix = "R"\n'
+         'count = 3\nseed = 1\nfaults = "random"', "given twice: R1"),
         ("[campaign\n", "not a valid TOML"),
     ],
 )  # fmt: skip
