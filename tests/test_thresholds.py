@@ -68,8 +68,8 @@ def test_requirements_are_parsed_with_their_units():
     [
         ("speed=1", "unknown requirement 'speed'"),
         ("tracking=1 A", "unit 'A' is not one for tracking"),
-        ("tracking=-0.5deg", "must be > 0"),
-        ("current=0", "must be > 0"),
+        ("tracking=-0.5deg", "number > 0"),
+        ("current=0", "number > 0"),
         ("tracking", "KIND=LIMIT"),
         ("tracking=I_max", "I_max is a current"),
         ("current=12 A", "above I_max"),
@@ -194,7 +194,7 @@ def test_cli_thresholds_writes_a_table_and_refuses_bad_input(tmp_path, capsys):
         ([], "give at least one --require"),
         (["--require", "speed=2"], "unknown requirement"),
         (["--require", "tracking=2 furlong"], "unit 'furlong'"),
-        (["--require", "tracking=-2deg"], "must be > 0"),
+        (["--require", "tracking=-2deg"], "number > 0"),
         (["--require", "tracking=0.5deg", "--fault", "friction"], "healthy actuator already reaches"),
         (["--require", "tracking=2deg", "-o", str(tmp_path / "t.txt")], "unsupported file type"),
     ]:

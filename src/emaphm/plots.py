@@ -189,7 +189,8 @@ def plot_rul(report: dict, path: Path) -> Path:
         lo, hi = trend.band(grid)
         ax.errorbar(t, trend.k, yerr=1.645 * np.asarray(trend.sd), fmt="o", ms=3, color="k", elinewidth=0.7,
                     label="identified (90 % interval)")  # fmt: skip
-        ax.plot(grid, trend.value(grid), "C0", lw=1.2, label=f"{f['law']} law")
+        fitted = f"{f['law']} law" + (" (ProgPy UKF)" if report.get("estimator") == "ukf" else "")
+        ax.plot(grid, trend.value(grid), "C0", lw=1.2, label=fitted)
         ax.fill_between(grid, lo, hi, color="C0", alpha=0.15, lw=0)
         mark = " (placeholder)" if f["placeholder"] else ""
         ax.axhline(f["threshold"], color="C3", lw=1, ls="--", label=f"threshold {f['threshold']:g}{mark}")

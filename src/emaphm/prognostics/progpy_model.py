@@ -15,15 +15,21 @@ law (next-features §B.3):
 - **exponential** (coil shorts): states ``f_log`` = ln d and ``f_rate`` = r, ln d(t + Δ) =
   ln d + r·Δ, so d = exp(ln d) stays positive, as the UKF needs (next-features §B.4);
 
-output ``f`` = d, event ``f_failure`` at d ≥ the fault's threshold, event state
-1 − d/threshold clipped to [0, 1]. A step is the law's exact solution, so the step size does not
-change a prediction, and there is no process noise unless asked for (`rate_walk`).
+output the level state (``f`` = d, or ``f_log`` = ln d), event ``f_failure`` at d ≥ the fault's
+threshold, event state 1 − d/threshold clipped to [0, 1]. The model is linear in its states, and a
+step is the law's exact solution, so the step size does not change a prediction. The exponential
+law is observed in log space, ln max(d, `EXP_FLOOR`) with the deviation sd/d, as
+`DegradationTrend` fits it: observed as d, the filter's sigma points spread ln d by the rate's
+uncertainty times the gap between measurements, and exp() of that broke the unscented transform
+on measurements 10 flights apart (a review found a posterior d of 3·10⁵ against a measured 0.06).
+There is no process noise unless asked for (`rate_walk`).
 
 `track` runs ``progpy.state_estimators.UnscentedKalmanFilter`` over one fault's measurements,
 setting the filter's measurement covariance R before every update to that identification's own
 variance: ProgPy's UKF otherwise keeps the R given at construction (next-features §B.1).
 Measurements at the same flight (several seeds) are pooled by their precisions first, because the
-filter's time must increase. `predict_rul` draws the posterior state and solves each draw's
+filter's time must increase; flights are whole numbers (ProgPy's filter steps its clock by
+additions, which fractional times would round past the next measurement). `predict_rul` draws the posterior state and solves each draw's
 crossing in closed form (microseconds); `montecarlo_toe` asks ProgPy's ``MonteCarlo`` predictor
 the same question by simulation, with ``t0`` set and never-crossing draws as ``inf``, not
 ``None`` (the tests hold the two to each other). `toe_profile` and `progpy_metrics` give ProgPy's
@@ -56,6 +62,7 @@ except ImportError as exc:  # pragma: no cover - exercised by the test without p
 
 __all__ = [
     "FaultGrowth",
+    "UkfTrend",
     "montecarlo_toe",
     "predict_rul",
     "progpy_metrics",
@@ -79,8 +86,10 @@ class FaultGrowth(PrognosticsModel):  # type: ignore[misc]
         Each fault's law ("linear" or "exponential") and failure threshold (a distance from
         healthy, > 0), e.g. ``{"friction": ("linear", 0.45), "short_b": ("exponential", 0.2)}``.
     rate_walk : float
-        Standard deviation of a random walk of each rate per flight (process noise, applied by
-        the UKF's Q; 0: the rate is constant, and the filter is Bayesian regression).
+        Standard deviation of a random walk of each rate per flight (0: the rate is constant, and
+        the filter is Bayesian regression). `track` gives the filter Q = rate_walk²·Δ for a gap of
+        Δ flights; in ProgPy's own simulation it is the rate states' process noise, which ProgPy
+        applies as dt·N(0, σ) per step: simulate with dt = 1 flight.
     **kwargs
         ProgPy model parameters (``x0``, ...).
     """
@@ -100,12 +109,16 @@ class FaultGrowth(PrognosticsModel):  # type: ignore[misc]
                     f"{name}: a failure threshold is a distance from healthy > 0, got {threshold!r}"
                 )
             self.laws[name], self.thresholds[name] = law, float(threshold)
+        if not (math.isfinite(rate_walk) and rate_walk >= 0):
+            raise InputError(f"rate_walk is a standard deviation per flight >= 0, got {rate_walk!r}")
         self.rate_walk = float(rate_walk)
         self.inputs: list[str] = []
         self.states = [s for name in self.laws for s in (self.level_state(name), f"{name}_rate")]
-        self.outputs = list(self.laws)
+        self.outputs = [self.level_state(name) for name in self.laws]
         self.events = [f"{name}_failure" for name in self.laws]
-        kwargs.setdefault("process_noise", 0.0)
+        kwargs.setdefault(
+            "process_noise", {s: self.rate_walk if s.endswith("_rate") else 0.0 for s in self.states}
+        )
         kwargs.setdefault("measurement_noise", 0.0)
         kwargs.setdefault("x0", {s: 0.0 for s in self.states})
         super().__init__(**kwargs)
@@ -127,7 +140,7 @@ class FaultGrowth(PrognosticsModel):  # type: ignore[misc]
         return self.StateContainer(out)
 
     def output(self, x: Any) -> Any:
-        return self.OutputContainer({name: self._level(x, name) for name in self.laws})
+        return self.OutputContainer({s: x[s] for s in self.outputs})  # d, or ln d (observed in log space)
 
     def event_state(self, x: Any) -> dict[str, Any]:
         return {
@@ -165,32 +178,70 @@ def track(
 ) -> tuple[FaultGrowth, Any]:
     """Track one fault with ProgPy's UKF: the model and the filter after the last measurement.
 
-    `values` are distances from healthy at `flights`, each with its identification's standard
-    deviation `sds` (a non-finite or non-positive sd: the measurement is left out). The filter
-    starts at the first flight from that measurement (ln of it, floored at `EXP_FLOOR`, for the
-    exponential law) and a rate prior of `RATE_PRIOR_SD`; R is that identification's variance at
-    every update."""
+    `values` are distances from healthy at whole-numbered `flights`, each with its
+    identification's standard deviation `sds` (a non-finite or non-positive sd: the measurement is
+    left out). The exponential law is observed in log space (see the module docstring). The
+    filter starts at the first flight from that measurement and a rate prior of `RATE_PRIOR_SD`;
+    R is that identification's variance at every update, Q the rate's walk over the gap."""
     t, k, sd = _pooled(flights, values, sds)
     if len(t) < 2:
         raise InputError(f"{name}: a trend needs measurements at two flights at least")
+    if not np.all(t == np.round(t)):
+        raise InputError(f"{name}: flights are whole numbers, got {t[t != np.round(t)][0]!r}")
     model = FaultGrowth({name: (law, threshold)}, rate_walk=rate_walk)
     level = model.level_state(name)
-    if law == "exponential":
-        k0 = max(k[0], EXP_FLOOR)
-        mean0, sd0 = math.log(k0), min(sd[0] / k0, 3.0)
-    else:
-        mean0, sd0 = k[0], sd[0]
+    z, r = _observed(law, k, sd)
     x0 = MultivariateNormalDist(
-        [level, f"{name}_rate"], [mean0, 0.0], np.diag([sd0**2, RATE_PRIOR_SD[law] ** 2])
+        [level, f"{name}_rate"], [z[0], 0.0], np.diag([r[0] ** 2, RATE_PRIOR_SD[law] ** 2])
     )
-    q = np.diag([1e-12, max(rate_walk**2, 1e-12)])  # a floor keeps the sigma points' Cholesky defined
+    floor = 1e-12  # keeps the sigma points' Cholesky defined where the state is not noisy
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # ProgPy warns about its own internals
-        ukf = UnscentedKalmanFilter(model, x0, t0=float(t[0]), alpha=1.0, beta=0.0, kappa=0.0, Q=q)
-        for ti, ki, si in zip(t[1:], k[1:], sd[1:], strict=True):
-            ukf.filter.R = np.array([[si**2]])  # this identification's variance (fixed otherwise)
-            ukf.estimate(float(ti), {}, {name: float(ki)})
+        ukf = UnscentedKalmanFilter(model, x0, t0=float(t[0]), alpha=1.0, beta=0.0, kappa=0.0)
+        for t_prev, ti, zi, ri in zip(t[:-1], t[1:], z[1:], r[1:], strict=True):
+            ukf.filter.Q = np.diag([floor, max(rate_walk**2 * (ti - t_prev), floor)])  # the walk over the gap
+            ukf.filter.R = np.array([[ri**2]])  # this identification's variance (fixed otherwise)
+            ukf.estimate(float(ti), {}, {level: float(zi)}, dt=float(ti - t_prev))  # one step per gap
     return model, ukf
+
+
+def _observed(
+    law: str, k: NDArray[np.float64], sd: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The observed level and its deviation: d and sd, or ln max(d, EXP_FLOOR) and sd/max(d, EXP_FLOOR)."""
+    if law == "exponential":
+        kk = np.maximum(k, EXP_FLOOR)
+        return np.log(kk), sd / kk
+    return k, sd
+
+
+class UkfTrend:
+    """The UKF's fitted law of one fault, for a figure: `t`, `k`, `sd` (the measurements), `law`,
+    ``value(t)`` and ``band(t)`` (the posterior at the last flight carried along the law), the
+    interface of `DegradationTrend` that `emaphm.plots.plot_rul` draws."""
+
+    def __init__(self, model: FaultGrowth, ukf: Any, t: Any, k: Any, sd: Any) -> None:
+        (self.law,) = model.laws.values()
+        self.t, self.k, self.sd = list(t), list(k), list(sd)
+        self._x = np.asarray(ukf.filter.x, dtype=np.float64)
+        self._P = np.asarray(ukf.filter.P, dtype=np.float64)
+        self._t_last = float(ukf.t)
+
+    def _line(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        dt = np.asarray(t, dtype=np.float64) - self._t_last
+        P = self._P
+        return self._x[0] + self._x[1] * dt, np.sqrt(
+            np.maximum(P[0, 0] + 2 * dt * P[0, 1] + dt**2 * P[1, 1], 0.0)
+        )
+
+    def value(self, t: ArrayLike) -> NDArray[np.float64]:
+        y, _ = self._line(t)
+        return np.exp(y) if self.law == "exponential" else y
+
+    def band(self, t: ArrayLike, z: float = 1.645) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        y, s = self._line(t)
+        lo, hi = y - z * s, y + z * s
+        return (np.exp(lo), np.exp(hi)) if self.law == "exponential" else (lo, hi)
 
 
 def _state_draws(ukf: Any, n: int, seed: int) -> NDArray[np.float64]:
@@ -213,7 +264,9 @@ def predict_rul(
     level, rate = draws[:, 0], draws[:, 1]
     g = math.log(model.thresholds[name]) if model.laws[name] == "exponential" else model.thresholds[name]
     with np.errstate(divide="ignore", invalid="ignore"):
-        toe = np.where(level >= g, t_last, np.where(rate > 0, t_last + (g - level) / rate, NEVER))
+        toe = np.where(rate > 0, t_last + (g - level) / rate, NEVER)
+    # a draw already past the threshold at t_now has failed, whichever way its rate points
+    toe = np.where(level + rate * (t_now - t_last) >= g, np.minimum(toe, t_now), toe)
     return RulEstimate.from_samples(np.maximum(toe - t_now, 0.0), t_now)
 
 
@@ -268,7 +321,9 @@ def progpy_metrics(
     prediction at or after `lambda_value`: at least `beta` of the draws within α of the true RUL),
     the prognostic horizon (from the first prediction whose median lies within α·(life) of the
     truth, where life counts from `onset`, default the first prediction) and the cumulative relative
-    accuracy. Returns {event: {"alpha_lambda", "prognostic_horizon", "cra"}}."""
+    accuracy (ProgPy's: of the time of event, from the *mean* of the draws, so a draw that never
+    crosses pulls it by the `never` it was given in `toe_profile`). Returns {event:
+    {"alpha_lambda", "prognostic_horizon", "cra"}}."""
     from progpy.metrics import alpha_lambda, cumulative_relative_accuracy, prognostic_horizon
 
     first = min(profile.keys()) if onset is None else float(onset)

@@ -139,6 +139,8 @@ def rul_report(
     JSON) hold the fitted trends and the draws, for a plot."""
     if estimator not in ESTIMATORS:
         raise InputError(f"unknown estimator {estimator!r}; use one of {', '.join(ESTIMATORS)}")
+    if estimator == "ukf":
+        from . import progpy_model  # the extra is needed whether or not a fault is tracked
     rows = history(store, actuator, campaign)
     if at_flight is not None:
         rows = [r for r in rows if r["flight"] <= at_flight]
@@ -175,10 +177,9 @@ def rul_report(
                             "rul_p95": None}  # fmt: skip
             continue
         if estimator == "ukf":
-            from . import progpy_model
-
             model, ukf = progpy_model.track(name, law, threshold, trend.t, trend.k, trend.sd)
             est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, seed + len(estimates))
+            trend = progpy_model.UkfTrend(model, ukf, trend.t, trend.k, trend.sd)  # type: ignore[assignment]
         else:
             est = trend.predict_rul(threshold, t_now, SAMPLES, seed + len(estimates))
         trends[name], estimates[name] = trend, est

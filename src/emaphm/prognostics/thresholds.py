@@ -107,7 +107,9 @@ class Requirement:
         if isinstance(limit, bool) or not (
             isinstance(limit, (int, float)) and math.isfinite(limit) and limit > 0
         ):
-            raise InputError(f"requirement {self.kind}: the limit must be a number > 0, got {self.limit!r}")
+            raise InputError(
+                f"requirement {self.kind}: the limit must be a finite number > 0, got {self.limit!r}"
+            )
         si = self.si_unit
         if self.unit and self.unit not in UNITS[si]:
             raise InputError(
@@ -187,7 +189,7 @@ def parse_requirement(text: str, *, params: EmaParams | None = None, where: str 
         return req.resolve(params if params is not None else EmaParams())
     value = float(_value(raw, kind, si, where))
     if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{where}: {kind} = {raw!r}: the limit must be > 0")
+        raise InputError(f"{where}: {kind} = {raw!r}: the limit must be a finite number > 0")
     match = _QUANTITY.match(raw)  # _value parsed it: a number, then a unit of the kind or none
     unit = _normalise_unit(match.group(2)) if match is not None and match.group(2) else si
     req = Requirement(kind, value, raw, unit)

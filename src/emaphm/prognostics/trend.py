@@ -154,8 +154,12 @@ class DegradationTrend:
 
     # -- the prediction -------------------------------------------------------------------------
 
-    def crossing_samples(self, threshold: float, n: int = 4000, seed: int = 0) -> NDArray[np.float64]:
-        """Draws of the flight at which the trend reaches `threshold` (distance from healthy)."""
+    def crossing_samples(
+        self, threshold: float, n: int = 4000, seed: int = 0, t_now: float | None = None
+    ) -> NDArray[np.float64]:
+        """Draws of the flight at which the trend reaches `threshold` (distance from healthy); with
+        `t_now`, a draw already past the threshold then has crossed by `t_now`, whichever way its
+        slope points (a falling trend above the threshold has failed, it does not "never" fail)."""
         if not threshold > 0:
             raise InputError(
                 f"a failure threshold must lie beyond the healthy value, got a distance {threshold!r}"
@@ -166,6 +170,8 @@ class DegradationTrend:
         phi, theta = draws[:, 0], draws[:, 1]
         with np.errstate(divide="ignore", invalid="ignore"):
             t_star = np.where(theta > 0, (g - phi) / theta, np.inf)
+        if t_now is not None:
+            t_star = np.where(phi + theta * t_now >= g, np.minimum(t_star, t_now), t_star)
         return np.asarray(t_star, dtype=np.float64)
 
     def predict_rul(
@@ -174,5 +180,5 @@ class DegradationTrend:
         """The RUL in flights from `t_now` (default: the last measurement) to the crossing of
         `threshold` (a distance from healthy); 0 where the draw has already crossed."""
         t_now = max(self.t) if t_now is None else float(t_now)
-        rul = np.maximum(self.crossing_samples(threshold, n, seed) - t_now, 0.0)
+        rul = np.maximum(self.crossing_samples(threshold, n, seed, t_now) - t_now, 0.0)
         return RulEstimate.from_samples(rul, t_now)
