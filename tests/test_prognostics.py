@@ -118,3 +118,34 @@ def test_thresholds_from_the_actuator_file(tmp_path):
     with pytest.raises(InputError, match="unknown fault 'fricton'"):
         load_thresholds(tmp_path / "b.toml")
     assert parse_thresholds(["kp_drift=0.25"]) == {"kp_drift": 0.25}
+
+
+def test_correlated_estimates_make_correlated_trends_for_the_first_failure(tmp_path):
+    # friction and backlash measured alike (the same values and deviations), so that they cross
+    # their equal thresholds together; their estimates come with a correlation in each
+    # identification (the store's corr). Drawn independently, the earlier of two equal crossings
+    # lies ~0.56 sd before either's median; correlated at 0.95, ~0.13 sd (E[min] of two normals)
+    flights = np.arange(1, 21)
+    k = 0.05 + 0.01 * flights
+
+    def store(rho, folder):
+        rows = _rows("A1", flights, k, 0.01, detected_from=1)
+        for r, n in zip(rows, flights, strict=True):
+            r.update(k2=0.05 + 0.01 * n, std_k2=0.01,
+                     fault_verdicts=json.dumps({"friction": "present", "backlash": "present"}))  # fmt: skip
+            corr = np.eye(8)
+            corr[0, 1] = corr[1, 0] = 0.0 if rho is None else rho
+            r["corr"] = json.dumps(corr.tolist()) if rho is not None else None
+        ResultStore(tmp_path / folder).write("results", rows)
+        return rul_report(tmp_path / folder, "A1", thresholds={"friction": 0.45, "backlash": 0.45})
+
+    independent, correlated, unknown = store(0.0, "a"), store(0.95, "b"), store(None, "c")
+    assert correlated["first_failure"]["correlations"] == {"friction/backlash": 0.95}
+    assert unknown["first_failure"]["correlations"] == {"friction/backlash": 0.0}  # none recorded
+    gaps = []
+    for report in (independent, correlated):
+        f = report["faults"]["friction"]
+        assert f["rul_median"] == pytest.approx(report["faults"]["backlash"]["rul_median"], abs=0.05)
+        sd = (f["rul_p95"] - f["rul_p05"]) / 3.29
+        gaps.append((f["rul_median"] - report["first_failure"]["rul_median"]) / sd)
+    assert 0.4 < gaps[0] < 0.75 and 0.0 <= gaps[1] < 0.2

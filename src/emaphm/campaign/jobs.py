@@ -60,6 +60,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
         "job_key": job["key"], "campaign": job["campaign"], "actuator": job["actuator"],
         "flight": job["flight"], "seed": job["seed"], "identify_seed": job["identify_seed"],
         "uq_method": data["uq_method"], "uq_flags": None if data["uq_flags"] is None else json.dumps(data["uq_flags"]),
+        "corr": None if data.get("corr") is None else json.dumps(data["corr"]),
         "verdict": data["verdict"], "detected": ",".join(data["detected"]),
         "fault_verdicts": None if data["fault_verdicts"] is None else json.dumps(data["fault_verdicts"]),
         "fit_nrmse": data["fit_nrmse"], "fitness": data["fitness"], "evaluations": data["evaluations"],

@@ -244,15 +244,21 @@ class UkfTrend:
         return (np.exp(lo), np.exp(hi)) if self.law == "exponential" else (lo, hi)
 
 
-def _state_draws(ukf: Any, n: int, seed: int) -> NDArray[np.float64]:
-    return np.random.default_rng(seed).multivariate_normal(
-        np.asarray(ukf.filter.x, dtype=np.float64), np.asarray(ukf.filter.P, dtype=np.float64), size=n,
-        method="eigh",
-    )  # fmt: skip
+def _state_draws(ukf: Any, n: int, seed: int, z: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    x, P = np.asarray(ukf.filter.x, dtype=np.float64), np.asarray(ukf.filter.P, dtype=np.float64)
+    if z is None:
+        z = np.random.default_rng(seed).standard_normal((n, len(x)))
+    w, V = np.linalg.eigh((P + P.T) / 2)
+    return np.asarray(x + z @ (V * np.sqrt(np.maximum(w, 0.0))).T, dtype=np.float64)
 
 
 def predict_rul(
-    model: FaultGrowth, ukf: Any, t_now: float | None = None, n: int = 4000, seed: int = 0
+    model: FaultGrowth,
+    ukf: Any,
+    t_now: float | None = None,
+    n: int = 4000,
+    seed: int = 0,
+    z: NDArray[np.float64] | None = None,
 ) -> RulEstimate:
     """The RUL in flights from `t_now` (default: the filter's last flight) of `track`'s single
     fault: the posterior drawn `n` times, each draw's crossing solved in closed form (a draw whose
@@ -260,7 +266,7 @@ def predict_rul(
     (name,) = model.laws
     t_last = float(ukf.t)
     t_now = t_last if t_now is None else float(t_now)
-    draws = _state_draws(ukf, n, seed)
+    draws = _state_draws(ukf, n, seed, z)
     level, rate = draws[:, 0], draws[:, 1]
     g = math.log(model.thresholds[name]) if model.laws[name] == "exponential" else model.thresholds[name]
     with np.errstate(divide="ignore", invalid="ignore"):

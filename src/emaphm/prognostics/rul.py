@@ -21,6 +21,7 @@ import os
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import InputError
 from .trend import DegradationTrend, RulEstimate
@@ -45,6 +46,7 @@ PLACEHOLDER_THRESHOLDS: dict[str, float] = {
     "eccentricity": 0.3, "kp_drift": 0.3,
 }  # fmt: skip
 SAMPLES = 4000
+_NO_RUL = {"rul_median": None, "rul_p05": None, "rul_p95": None}
 ESTIMATORS = ("trend", "ukf")
 
 
@@ -114,6 +116,39 @@ def _measurement(row: dict[str, Any], name: str) -> tuple[float, float] | None:
     return float(row[column]), float(sd)
 
 
+def _correlations(rows: list[dict[str, Any]], names: list[str]) -> NDArray[np.float64]:
+    """The mean correlation between the estimates of faults `names` over the rows that sized both
+    (each identification's ``corr``; none recorded: 0), as a correlation matrix."""
+    n = len(names)
+    total, count = np.zeros((n, n)), np.zeros((n, n))
+    for row in rows:
+        corr = json.loads(row["corr"]) if row.get("corr") else None
+        if corr is None:
+            continue
+        used = [_measurement(row, name) is not None for name in names]
+        for a in range(n):
+            for b in range(a + 1, n):
+                ja, jb = (int(FAULTS[names[i]][0][1:]) - 1 for i in (a, b))
+                value = corr[ja][jb]
+                if used[a] and used[b] and value is not None and math.isfinite(value):
+                    total[a, b] += value
+                    count[a, b] += 1
+    rho = np.divide(total, count, out=np.zeros((n, n)), where=count > 0)
+    rho = rho + rho.T + np.eye(n)
+    w, V = np.linalg.eigh(rho)  # a mean of correlation matrices is one; clip rounding below 0
+    rho = (V * np.maximum(w, 1e-9)) @ V.T
+    d = np.sqrt(np.diag(rho))
+    return np.asarray(rho / np.outer(d, d), dtype=np.float64)
+
+
+def _joint_normals(rho: NDArray[np.float64], n: int, dims: int, seed: int) -> NDArray[np.float64]:
+    """(faults, n, dims) standard normal draws, fault f's correlated with fault g's by rho[f, g]
+    component by component (a Gaussian copula on the trends' posteriors)."""
+    L = np.linalg.cholesky(rho)
+    z = np.random.default_rng(seed).standard_normal((n, dims, len(rho)))
+    return np.asarray(np.moveaxis(z @ L.T, -1, 0), dtype=np.float64)
+
+
 def _detected(row: dict[str, Any], name: str) -> bool:
     verdicts = json.loads(row["fault_verdicts"]) if row.get("fault_verdicts") else None
     if verdicts is not None:
@@ -149,20 +184,15 @@ def rul_report(
     t_now = float(at_flight if at_flight is not None else rows[-1]["flight"])
     given = dict(thresholds or {})
     faults: dict[str, Any] = {}
-    trends: dict[str, DegradationTrend] = {}
+    trends: dict[str, Any] = {}
     estimates: dict[str, RulEstimate] = {}
+    tracked: dict[str, tuple[DegradationTrend, float, dict[str, Any]]] = {}
     for name, (_, law, healthy) in FAULTS.items():
         threshold = given.get(name, PLACEHOLDER_THRESHOLDS[name])
         entry: dict[str, Any] = {"law": law, "threshold": threshold, "placeholder": name not in given}
         onset = next((r["flight"] for r in rows if _detected(r, name)), None)
         if onset is None:
-            faults[name] = {
-                **entry,
-                "status": "not detected",
-                "rul_median": None,
-                "rul_p05": None,
-                "rul_p95": None,
-            }
+            faults[name] = {**entry, "status": "not detected", **_NO_RUL}
             continue
         trend = DegradationTrend(law, healthy)
         used = [
@@ -173,18 +203,28 @@ def rul_report(
         trend.update([f for f, _ in used], [m[0] for _, m in used], [m[1] for _, m in used])
         entry.update(tracked_from=onset, measurements=len(trend))
         if len(set(trend.t)) < 2:
-            faults[name] = {**entry, "status": "too few measurements", "rul_median": None, "rul_p05": None,
-                            "rul_p95": None}  # fmt: skip
+            faults[name] = {**entry, "status": "too few measurements", **_NO_RUL}
             continue
+        tracked[name] = (trend, threshold, entry)
+    # the faults' trends drawn together: estimates of one identification are correlated (its
+    # corr), and so are the trends fitted to them; this matters for the first failure
+    drawn = list(tracked)
+    rho = _correlations(rows, drawn) if drawn else np.eye(0)
+    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
+    for i, name in enumerate(drawn):
+        trend, threshold, entry = tracked[name]
+        assert normals is not None
         if estimator == "ukf":
-            model, ukf = progpy_model.track(name, law, threshold, trend.t, trend.k, trend.sd)
-            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, seed + len(estimates))
-            trend = progpy_model.UkfTrend(model, ukf, trend.t, trend.k, trend.sd)  # type: ignore[assignment]
+            model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
+            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
+            trends[name] = progpy_model.UkfTrend(model, ukf, trend.t, trend.k, trend.sd)
         else:
-            est = trend.predict_rul(threshold, t_now, SAMPLES, seed + len(estimates))
-        trends[name], estimates[name] = trend, est
+            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
+            trends[name] = trend
+        estimates[name] = est
         faults[name] = {**entry, "status": "tracked", **est.to_json(),
                         "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
+    faults = {name: faults[name] for name in FAULTS}  # in the order of FAULTS
     first: dict[str, Any] = {"status": "no fault tracked"}
     if estimates:
         stacked = np.vstack([e.samples for e in estimates.values()])
@@ -193,6 +233,8 @@ def rul_report(
         names, counts = np.unique(which, return_counts=True)
         first = {
             "status": "tracked", **est.to_json(),
+            "correlations": {f"{a}/{b}": round(float(rho[i, j]), 3) for i, a in enumerate(drawn)
+                             for j, b in enumerate(drawn) if j > i},
             "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4),
             "most_likely_fault": str(names[np.argmax(counts)]),
             "placeholder_thresholds": sorted(n for n in estimates if faults[n]["placeholder"]),

@@ -155,7 +155,12 @@ class DegradationTrend:
     # -- the prediction -------------------------------------------------------------------------
 
     def crossing_samples(
-        self, threshold: float, n: int = 4000, seed: int = 0, t_now: float | None = None
+        self,
+        threshold: float,
+        n: int = 4000,
+        seed: int = 0,
+        t_now: float | None = None,
+        z: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
         """Draws of the flight at which the trend reaches `threshold` (distance from healthy); with
         `t_now`, a draw already past the threshold then has crossed by `t_now`, whichever way its
@@ -165,7 +170,9 @@ class DegradationTrend:
                 f"a failure threshold must lie beyond the healthy value, got a distance {threshold!r}"
             )
         mean, cov = self.fit()
-        draws = np.random.default_rng(seed).multivariate_normal(mean, cov, size=n, method="cholesky")
+        if z is None:  # (n, 2) standard normal draws; given, to correlate this trend with others
+            z = np.random.default_rng(seed).standard_normal((n, 2))
+        draws = mean + z @ np.linalg.cholesky(cov).T
         g = math.log(threshold) if self.law == "exponential" else threshold
         phi, theta = draws[:, 0], draws[:, 1]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -175,10 +182,17 @@ class DegradationTrend:
         return np.asarray(t_star, dtype=np.float64)
 
     def predict_rul(
-        self, threshold: float, t_now: float | None = None, n: int = 4000, seed: int = 0
+        self,
+        threshold: float,
+        t_now: float | None = None,
+        n: int = 4000,
+        seed: int = 0,
+        z: NDArray[np.float64] | None = None,
     ) -> RulEstimate:
         """The RUL in flights from `t_now` (default: the last measurement) to the crossing of
-        `threshold` (a distance from healthy); 0 where the draw has already crossed."""
+        `threshold` (a distance from healthy); 0 where the draw has already crossed. `z`: the
+        posterior's (n, 2) standard normal draws, when they are to be correlated with another
+        fault's (`emaphm.prognostics.rul`)."""
         t_now = max(self.t) if t_now is None else float(t_now)
-        rul = np.maximum(self.crossing_samples(threshold, n, seed, t_now) - t_now, 0.0)
+        rul = np.maximum(self.crossing_samples(threshold, n, seed, t_now, z) - t_now, 0.0)
         return RulEstimate.from_samples(rul, t_now)
