@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from .trend import EXP_FLOOR, LAWS, MIN_SD, RulEstimate
+from .trend import LAWS, MIN_SD, DegradationTrend, RulEstimate, crossings, observed
 
 try:
     from progpy import PrognosticsModel
@@ -190,7 +190,7 @@ def track(
         raise InputError(f"{name}: flights are whole numbers, got {t[t != np.round(t)][0]!r}")
     model = FaultGrowth({name: (law, threshold)}, rate_walk=rate_walk)
     level = model.level_state(name)
-    z, r = _observed(law, k, sd)
+    z, r = observed(law, k, sd)
     x0 = MultivariateNormalDist(
         [level, f"{name}_rate"], [z[0], 0.0], np.diag([r[0] ** 2, RATE_PRIOR_SD[law] ** 2])
     )
@@ -205,43 +205,22 @@ def track(
     return model, ukf
 
 
-def _observed(
-    law: str, k: NDArray[np.float64], sd: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The observed level and its deviation: d and sd, or ln max(d, EXP_FLOOR) and sd/max(d, EXP_FLOOR)."""
-    if law == "exponential":
-        kk = np.maximum(k, EXP_FLOOR)
-        return np.log(kk), sd / kk
-    return k, sd
+class UkfTrend(DegradationTrend):
+    """One fault's trend as the UKF sees it, for a figure: `trend`'s measurements, and the filter's
+    posterior of (level, rate) at its last flight carried back to the law's (φ, θ) at flight 0, so
+    that `DegradationTrend`'s ``value`` and ``band`` (what `emaphm.plots.plot_rul` draws) are the
+    UKF's."""
 
+    def __init__(self, trend: DegradationTrend, ukf: Any) -> None:
+        super().__init__(trend.law, trend.healthy)
+        self.t, self.k, self.sd = list(trend.t), list(trend.k), list(trend.sd)
+        J = np.array([[1.0, -float(ukf.t)], [0.0, 1.0]])  # φ = level − rate·t_last, θ = rate
+        x, P = np.asarray(ukf.filter.x, dtype=np.float64), np.asarray(ukf.filter.P, dtype=np.float64)
+        self._posterior = (J @ x, J @ P @ J.T)
 
-class UkfTrend:
-    """The UKF's fitted law of one fault, for a figure: `t`, `k`, `sd` (the measurements), `law`,
-    ``value(t)`` and ``band(t)`` (the posterior at the last flight carried along the law), the
-    interface of `DegradationTrend` that `emaphm.plots.plot_rul` draws."""
-
-    def __init__(self, model: FaultGrowth, ukf: Any, t: Any, k: Any, sd: Any) -> None:
-        (self.law,) = model.laws.values()
-        self.t, self.k, self.sd = list(t), list(k), list(sd)
-        self._x = np.asarray(ukf.filter.x, dtype=np.float64)
-        self._P = np.asarray(ukf.filter.P, dtype=np.float64)
-        self._t_last = float(ukf.t)
-
-    def _line(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        dt = np.asarray(t, dtype=np.float64) - self._t_last
-        P = self._P
-        return self._x[0] + self._x[1] * dt, np.sqrt(
-            np.maximum(P[0, 0] + 2 * dt * P[0, 1] + dt**2 * P[1, 1], 0.0)
-        )
-
-    def value(self, t: ArrayLike) -> NDArray[np.float64]:
-        y, _ = self._line(t)
-        return np.exp(y) if self.law == "exponential" else y
-
-    def band(self, t: ArrayLike, z: float = 1.645) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        y, s = self._line(t)
-        lo, hi = y - z * s, y + z * s
-        return (np.exp(lo), np.exp(hi)) if self.law == "exponential" else (lo, hi)
+    def fit(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The UKF's posterior mean and covariance of (φ, θ)."""
+        return self._posterior
 
 
 def _state_draws(ukf: Any, n: int, seed: int, z: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
@@ -269,10 +248,7 @@ def predict_rul(
     draws = _state_draws(ukf, n, seed, z)
     level, rate = draws[:, 0], draws[:, 1]
     g = math.log(model.thresholds[name]) if model.laws[name] == "exponential" else model.thresholds[name]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        toe = np.where(rate > 0, t_last + (g - level) / rate, NEVER)
-    # a draw already past the threshold at t_now has failed, whichever way its rate points
-    toe = np.where(level + rate * (t_now - t_last) >= g, np.minimum(toe, t_now), toe)
+    toe = crossings(level - rate * t_last, rate, g, t_now)  # the line through (t_last, level)
     return RulEstimate.from_samples(np.maximum(toe - t_now, 0.0), t_now)
 
 

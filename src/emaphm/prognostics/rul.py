@@ -217,7 +217,7 @@ def rul_report(
         if estimator == "ukf":
             model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
             est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
-            trends[name] = progpy_model.UkfTrend(model, ukf, trend.t, trend.k, trend.sd)
+            trends[name] = progpy_model.UkfTrend(trend, ukf)
         else:
             est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
             trends[name] = trend

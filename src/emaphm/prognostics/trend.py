@@ -30,12 +30,36 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 
-__all__ = ["LAWS", "DegradationTrend", "RulEstimate"]
+__all__ = ["LAWS", "DegradationTrend", "RulEstimate", "crossings", "observed"]
 
 LAWS = ("linear", "exponential")
 PRIOR_SD = 1e3  # [k units, k per flight] a prior that says nothing at the scale of a fault in [0, 1]
 EXP_FLOOR = 1e-3  # k below this is taken as this in log space (a fault not yet grown)
 MIN_SD = 1e-4  # a measurement's standard deviation is never taken below this [k units]
+
+
+def observed(
+    law: str, k: NDArray[np.float64], sd: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Distances `k` and their deviations `sd` on the law's scale: as they are (linear), or
+    ln max(k, `EXP_FLOOR`) with sd/max(k, `EXP_FLOOR`) (exponential; the delta method)."""
+    if law == "exponential":
+        kk = np.maximum(k, EXP_FLOOR)
+        return np.log(kk), sd / kk
+    return k, sd
+
+
+def crossings(
+    phi: NDArray[np.float64], theta: NDArray[np.float64], g: float, t_now: float | None = None
+) -> NDArray[np.float64]:
+    """The flights at which lines φ + θ·t (draws, on the law's scale) reach `g`: inf where θ <= 0;
+    with `t_now`, a draw already past `g` then has crossed by `t_now`, whichever way its slope
+    points (a falling trend above the threshold has failed, it does not "never" fail)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_star = np.where(theta > 0, (g - phi) / theta, np.inf)
+    if t_now is not None:
+        t_star = np.where(phi + theta * t_now >= g, np.minimum(t_star, t_now), t_star)
+    return np.asarray(t_star, dtype=np.float64)
 
 
 @dataclass(frozen=True)
@@ -116,10 +140,7 @@ class DegradationTrend:
 
     def _transformed(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         t, k, sd = (np.asarray(a, dtype=np.float64) for a in (self.t, self.k, self.sd))
-        if self.law == "exponential":
-            kk = np.maximum(k, EXP_FLOOR)
-            return t, np.log(kk), sd / kk  # delta method: sd(log k) = sd(k)/k
-        return t, k, sd
+        return (t, *observed(self.law, k, sd))
 
     def fit(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Posterior mean and covariance of (φ, θ), t in flights; `InputError` with < 2 flights."""
@@ -174,12 +195,7 @@ class DegradationTrend:
             z = np.random.default_rng(seed).standard_normal((n, 2))
         draws = mean + z @ np.linalg.cholesky(cov).T
         g = math.log(threshold) if self.law == "exponential" else threshold
-        phi, theta = draws[:, 0], draws[:, 1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t_star = np.where(theta > 0, (g - phi) / theta, np.inf)
-        if t_now is not None:
-            t_star = np.where(phi + theta * t_now >= g, np.minimum(t_star, t_now), t_star)
-        return np.asarray(t_star, dtype=np.float64)
+        return crossings(draws[:, 0], draws[:, 1], g, t_now)
 
     def predict_rul(
         self,
