@@ -208,14 +208,13 @@ def _fail(where: str, message: str) -> InputError:
     return InputError(f"{where}: {message}")
 
 
+def _number(v: Any) -> bool:
+    """A finite int or float, not a bool."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
 def _vector(value: Any, name: str, where: str, *, faults: bool) -> tuple[float, ...]:
-    if (
-        not isinstance(value, list)
-        or len(value) != 8
-        or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value
-        )
-    ):
+    if not isinstance(value, list) or len(value) != 8 or not all(_number(v) for v in value):
         raise _fail(where, f"{name} must be a list of 8 numbers, got {value!r}")
     if faults:
         try:
@@ -259,14 +258,13 @@ def _drawn(
     value: Any, name: str, where: str, rng: np.random.Generator, count: int, *, faults: bool
 ) -> NDArray[np.float64]:
     """`count` draws of an 8-vector whose elements are numbers or [low, high] (uniform), (count, 8)."""
-    number = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)  # noqa: E731
     if not isinstance(value, list) or len(value) != 8:
         raise _fail(where, f"{name} must be a list of 8 numbers or [low, high] pairs, got {value!r}")
     low, high = np.empty(8), np.empty(8)
     for j, v in enumerate(value):
-        if number(v):
+        if _number(v):
             low[j] = high[j] = float(v)
-        elif isinstance(v, list) and len(v) == 2 and all(number(x) for x in v) and v[0] <= v[1]:
+        elif isinstance(v, list) and len(v) == 2 and all(_number(x) for x in v) and v[0] <= v[1]:
             low[j], high[j] = float(v[0]), float(v[1])
         else:
             raise _fail(where, f"{name}[{j}] must be a number or [low, high] with low <= high, got {v!r}")
