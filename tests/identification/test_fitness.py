@@ -69,7 +69,7 @@ def test_reference_on_another_grid_is_interpolated():
 
 def test_the_moving_mask_leaves_out_only_a_long_hold_where_the_surface_rests():
     from emaphm.commands import ChirpHold, Steps
-    from emaphm.identification.fitness import REST_BAND, moving_mask
+    from emaphm.identification.fitness import HOLD_SETTLE_S, PARK_SETTLE_S, REST_BAND, moving_mask
 
     f_s = 1e4
     t = np.arange(20001) / f_s
@@ -80,7 +80,11 @@ def test_the_moving_mask_leaves_out_only_a_long_hold_where_the_surface_rests():
     # with the surface position: left out only where it rests as well
     at_rest = 0.3 * REST_BAND * np.sin(2 * np.pi * 50 * t)  # noise within the band
     creeping = at_rest + np.where(t > 1.2, 100 * REST_BAND * (t - 1.2), 0.0)  # 5 bands per 50 ms
-    np.testing.assert_array_equal(moving_mask(hold, f_s, theta_u=at_rest), m)
+    # in a park (a hold longer than LONG_HOLD_S) a measured rest is seen after PARK_SETTLE_S
+    parked = moving_mask(hold, f_s, theta_u=at_rest)
+    stop = 1.05 + PARK_SETTLE_S
+    assert np.all(parked[t <= stop] == 1.0) and np.all(parked[t > stop + 2e-4] == 0.0)
+    np.testing.assert_array_equal(moving_mask(hold, f_s, theta_u=at_rest, park_settle=HOLD_SETTLE_S), m)
     kept = moving_mask(hold, f_s, theta_u=creeping)
     assert np.all(kept[t > 1.3] == 1.0) and np.all(kept[(t > 1.11) & (t < 1.2)] == 0.0)
     # steps of 0.2 s: without a position, dwells shorter than LONG_HOLD_S stay whole (the surface
@@ -134,3 +138,47 @@ def test_a_fast_recording_is_low_passed_before_it_is_resampled():
         np.testing.assert_array_equal(
             resample(t_same, x, grid[: len(grid) - 1], F_S), np.interp(grid[:-1], t_same, x)
         )
+
+
+def test_command_frequency_reads_a_sine_a_chirp_and_ignores_noise():
+    from emaphm.commands import Steps
+    from emaphm.identification.fitness import command_frequency
+
+    f_s = 1e4
+    t = np.arange(20001) / f_s
+    sine = 0.05 * np.sin(2 * np.pi * 3.0 * t)
+    f = command_frequency(sine, f_s)
+    np.testing.assert_allclose(f, 3.0, rtol=0.01)
+    # a recorded command's quantisation (16 bits over ±0.3 rad) and a noise of one LSB make no reversals
+    rng = np.random.default_rng(0)
+    lsb = 0.6 / 2**16
+    noisy = lsb * np.round(sine / lsb) + lsb * rng.standard_normal(t.shape)
+    np.testing.assert_allclose(command_frequency(noisy, f_s), 3.0, rtol=0.02)
+    # the chirp run on to 2 s: each half period's frequency lies within its span of the sweep
+    chirp = Chirp(T=2.0, f1=19.5)
+    fc = command_frequency(chirp(t), f_s)
+    inner = (t > 0.3) & (t < 1.9)
+    half = 0.5 / fc[inner]  # the half period each sample lies in
+    sweep = lambda when: chirp.f0 + (chirp.f1 - chirp.f0) * when / chirp.T  # noqa: E731
+    assert np.all(fc[inner] > 0.97 * sweep(t[inner] - half)) and np.all(
+        fc[inner] < 1.03 * sweep(t[inner] + half)
+    )
+    # a staircase reverses every dwell or two at most; a hold or a ramp does not oscillate
+    assert 0 < command_frequency(Steps(dwell=0.2)(t), f_s).max() <= 2.5 + 1e-9
+    assert np.all(command_frequency(np.zeros_like(t), f_s) == 0.0)
+    assert np.all(command_frequency(0.01 * t, f_s) == 0.0)
+
+
+def test_the_band_mask_leaves_out_only_motion_faster_than_the_fdi_chirp():
+    from emaphm.commands import ChirpHold, Steps
+    from emaphm.identification.fitness import BAND_HZ, band_mask
+
+    f_s = 1e4
+    t = np.arange(20001) / f_s
+    assert BAND_HZ == Chirp().f1  # the fastest motion the monitor was fitted on
+    for command in (Chirp(), ChirpHold(), Steps()):  # what the monitor was fitted and checked on
+        assert np.all(band_mask(command(t[t <= command.duration]), f_s) == 1.0)
+    m = band_mask(Chirp(T=2.0, f1=19.5)(t), f_s)  # the chirp run on to 19.5 Hz: from about 1 s
+    first = t[np.argmin(m)]
+    assert 0.95 < first < 1.08 and np.all(m[t > first] == 0.0) and np.all(m[t < first] == 1.0)
+    assert np.all(band_mask(0.005 * np.sin(2 * np.pi * 15 * t), f_s) == 0.0)

@@ -125,3 +125,40 @@ def test_phase_map_wraps_and_keeps_every_phase_away_from_the_bounds():
     # every phase in [0, 1) is reached from some x7 in [0.25, 0.75], away from the bounds
     inner = k[(x[:, 6] >= 0.25) & (x[:, 6] <= 0.75), 6]
     assert inner.min() == 0.0 and inner.max() >= 0.99 - 1e-12  # grid step 0.01 in k7
+
+
+def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitted():
+    """The chirp run on to 2 s: the second above 10 Hz is left out, and not simulated at all."""
+    from emaphm.commands import Chirp, SampledCommand
+    from emaphm.identification.fitness import Fitness
+    from emaphm.identification.identify import TAIL_MARGIN_S, FaultIdentifier
+    from emaphm.identification.signals import Comparison
+    from emaphm.models import HighFidelityEma, MonitorEma
+
+    command = Chirp(T=2.0, f1=19.5)
+    k = np.array([0.2, 0.3, 0.3, 0.1, 0.0, 0.2, 0.4, 0.1])
+    trace = HighFidelityEma(command=command).simulate(k, noise=False)
+    recorded = SampledCommand(trace.t, trace.theta_cmd)
+    ident = FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, recorded, trace.theta_u)
+    assert 0.45 < ident.above_band_ < 0.55 and ident.compared_ == pytest.approx(
+        1 - ident.above_band_, abs=1e-3
+    )
+    last = ident.reference_.t[np.flatnonzero(ident.mask_)[-1]]
+    assert ident.duration_ == pytest.approx(last + TAIL_MARGIN_S, abs=2e-4) and ident.duration_ < 1.2
+    # the same eq. (3) as over the whole recording with the same samples compared: the filter's
+    # edge at the cut stays clear of them
+    monitor, f_s = ident.monitor_, ident.monitor_.params.controller.f_s
+    grid, _ = monitor.sample_grid(None)
+    whole = Comparison.from_trace(trace.t, trace.i_q, grid, f_s)
+    mask = np.zeros(len(grid))
+    mask[: len(ident.mask_)] = ident.mask_
+    K = np.array([k, 0.8 * k, np.full(8, 0.1)])
+    np.testing.assert_allclose(
+        ident.objective_.of_monitor(monitor, K, duration=ident.duration_),
+        Fitness(whole, "s", mask).of_monitor(monitor, K),
+        rtol=1e-9,
+    )
+    # a command entirely above the band leaves nothing to compare: refused, not fitted
+    fast = SampledCommand(trace.t, 0.005 * np.sin(2 * np.pi * 15 * trace.t))
+    with pytest.raises(InputError, match="samples of the recording can be compared"):
+        FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, fast)

@@ -18,6 +18,7 @@ as ``fitness(monitor.simulate_many(K, check=False))`` without the serial filter 
 
 from __future__ import annotations
 
+import itertools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,7 +32,19 @@ from .signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 if TYPE_CHECKING:
     from ..models import MonitorEma
 
-__all__ = ["HOLD_SETTLE_S", "LONG_HOLD_S", "REST_BAND", "SLOPE_UNITS", "Fitness", "moving_mask"]
+__all__ = [
+    "BAND_HZ",
+    "HOLD_SETTLE_S",
+    "LONG_HOLD_S",
+    "PARK_SETTLE_S",
+    "REST_BAND",
+    "REVERSAL_FRACTION",
+    "SLOPE_UNITS",
+    "Fitness",
+    "band_mask",
+    "command_frequency",
+    "moving_mask",
+]
 
 SLOPE_UNITS = {"s": 1.0, "ms": 1e-3}  # the slope in A per this unit of time
 
@@ -42,9 +55,24 @@ HOLD_SETTLE_S = 0.05
 # without a measured position, only holds of the command longer than this count as rests
 LONG_HOLD_S = 0.5
 
+# in such a hold (the surface parked) the rest is seen after this [s], with a measured position:
+# on the chirp followed by a hold, 8 random cases x 2 seeds, %err median / p90 / max 4.62 / 7.20 /
+# 9.57 with `HOLD_SETTLE_S` and 2.77 / 5.3 / 6.12 with 20 ms. In a staircase's 0.2 s dwells the
+# rests after a step carry the breakaway friction: a 10 or 20 ms window there made one of 12 runs
+# 13-18 %err, so the dwells keep `HOLD_SETTLE_S` (docs/identification.md §3)
+PARK_SETTLE_S = 0.02
+
 # the surface counts as at rest while its measured position stays within this band [rad]: 10 LSB
 # of the 16-bit ±0.3 rad position sensor, 10 σ of its noise (DESIGN §7)
 REST_BAND = 1e-4
+
+
+def _trailing_spread(pos: NDArray[np.float64], window: int) -> NDArray[np.float64]:
+    """max − min of `pos` over the `window` + 1 samples ending at each sample (running max and min)."""
+    from scipy.ndimage import maximum_filter1d, minimum_filter1d
+
+    origin = window // 2  # trailing: the window ends at the sample
+    return maximum_filter1d(pos, window + 1, origin=origin) - minimum_filter1d(pos, window + 1, origin=origin)  # type: ignore[no-any-return]
 
 
 def moving_mask(
@@ -52,20 +80,27 @@ def moving_mask(
     f_s: float,
     settle: float = HOLD_SETTLE_S,
     theta_u: ArrayLike | None = None,
+    park_settle: float = PARK_SETTLE_S,
 ) -> NDArray[np.float64]:
-    """0 on the samples of a long hold where the surface is stuck, 1 everywhere else.
+    """0 on the samples of a hold where the surface is stuck, 1 everywhere else.
 
     A sample is left out when the command has not moved for more than `settle` [s] and the
     measured surface position `theta_u` [rad] has stayed within `REST_BAND` over that time too.
-    Without `theta_u` the rest of the surface is unknown: then only the holds of the command
-    longer than `LONG_HOLD_S` in all are taken as rests (after `settle`), so that the 0.2 s
-    dwells of a staircase, where the surface keeps hunting, stay whole. There the surface sits wherever stick-slip left it, and the position
-    loop's integrator ramps the current against that small error: the held current depends on the
+    In a hold longer than `LONG_HOLD_S` in all (the surface parked, not a staircase's dwell),
+    `park_settle` replaces `settle`: the rest is seen sooner. Without `theta_u` the rest of the
+    surface is unknown: then only the holds longer than `LONG_HOLD_S` are taken as rests (after
+    `settle`), so that the 0.2 s dwells of a staircase, where the surface keeps hunting, stay
+    whole.
+
+    Where the surface rests, it sits wherever stick-slip left it, and the position loop's
+    integrator ramps the current against that small error: the held current depends on the
     sticking point, not on the faults. On the chirp followed by a hold it differed by 30-37 mA RMS
     between the twin and the monitor at the true faults, against 16 mA over the chirp, and it drove
     identification to 25-40 %err (monitor-model.md §5). After a step the surface keeps moving
     (the loop hunts against friction and backlash) and those samples stay: they carry the faults.
-    A command that never holds keeps every sample.
+    The stop that begins a park is as chaotic (it follows the chirp's rattling end): its first
+    50 ms held 40-70 % of eq. (3) at the true faults on 5 random cases, hence `park_settle`. A
+    command that never holds keeps every sample.
     """
     theta = np.asarray(theta_cmd, dtype=np.float64)
     n = len(theta)
@@ -75,23 +110,88 @@ def moving_mask(
     still = np.zeros(n, dtype=bool)
     still[1:] = np.abs(np.diff(theta)) <= 1e-9 * max(peak, 1e-12)
     last_move = np.maximum.accumulate(np.where(still, 0, idx))  # the last sample the command moved
+    next_move = np.minimum.accumulate(np.where(still, n, idx)[::-1])[::-1]  # the next sample it moves
+    parked = (next_move - last_move) / f_s > LONG_HOLD_S
     held = still & (idx - last_move > window)
     if theta_u is None:
-        next_move = np.minimum.accumulate(np.where(still, n, idx)[::-1])[::-1]  # the next sample it moves
-        held &= (next_move - last_move) / f_s > LONG_HOLD_S
+        held &= parked
     else:
         pos = np.asarray(theta_u, dtype=np.float64)
         if pos.shape != theta.shape:
             raise ValueError(f"theta_u has shape {pos.shape}, theta_cmd {theta.shape}")
-        # the position's spread over the trailing window, by running max and min
-        from scipy.ndimage import maximum_filter1d, minimum_filter1d
-
-        origin = window // 2  # trailing: the window ends at the sample
-        spread = maximum_filter1d(pos, window + 1, origin=origin) - minimum_filter1d(
-            pos, window + 1, origin=origin
-        )
-        held &= spread <= REST_BAND
+        held &= _trailing_spread(pos, window) <= REST_BAND
+        short = max(round(park_settle * f_s), 1)
+        held |= still & parked & (idx - last_move > short) & (_trailing_spread(pos, short) <= REST_BAND)
     return np.where(held, 0.0, 1.0)
+
+
+# the fastest command the monitor is compared on [Hz]: the FDI chirp's top frequency (DESIGN §6),
+# the fastest motion the monitor was fitted on. Above it the monitor is far from the twin: on the
+# chirp run on to 19.5 Hz its error at the true faults (150 Hz filtered, per quarter second, 12
+# random cases) grows from 4-9 mA below 5 Hz to 10-25 mA above 10 Hz, where the surface sticks
+# and the motor rattles in the backlash; fitted whole, that trace gave 6.2 %err median, and 2.7
+# with the samples above 10 Hz left out (BENCHMARKS.md, "Other commands").
+BAND_HZ = 10.0
+
+# a turn of the command counts as a reversal once it has come back this fraction of its peak
+# excursion (so that a recorded command's quantisation or noise makes no reversals)
+REVERSAL_FRACTION = 0.01
+
+
+def command_frequency(theta_cmd: ArrayLike, f_s: float) -> NDArray[np.float64]:
+    """The command's local frequency [Hz] at each sample, from the spacing of its reversals.
+
+    A reversal is a turning point of θ_cmd confirmed once the command has come back from it by
+    more than `REVERSAL_FRACTION` of its peak excursion from the median. Between two successive
+    turning points the frequency is 1/(2·their spacing): half a period of a sine, the mean
+    frequency over that half period of a chirp. Before the first and after the last turning point
+    it is the neighbouring half period's, or 1/(2·the stretch) if that is lower (a hold that ends
+    the command reads as slow). A command with fewer than two turning points reads 0: a staircase
+    reads 1/(2·dwell) where it changes direction, a ramp or a hold 0.
+    """
+    theta = np.asarray(theta_cmd, dtype=np.float64)
+    n = len(theta)
+    f = np.zeros(n)
+    if n < 3:
+        return f
+    threshold = REVERSAL_FRACTION * max(float(np.max(np.abs(theta - np.median(theta)))), 1e-300)
+    values = theta.tolist()
+    turns: list[int] = []
+    direction, hi, lo = 0, 0, 0  # direction of travel (0: not yet known); the running high and low
+    for i in range(1, n):
+        v = values[i]
+        if v > values[hi]:
+            hi = i
+        if v < values[lo]:
+            lo = i
+        # the first move only sets the direction: where the command starts is no turning point
+        if direction >= 0 and values[hi] - v > threshold:  # came down from a high: a maximum
+            if direction:
+                turns.append(hi)
+            direction, lo = -1, i
+        elif direction <= 0 and v - values[lo] > threshold:  # came up from a low: a minimum
+            if direction:
+                turns.append(lo)
+            direction, hi = 1, i
+    if len(turns) < 2:
+        return f
+    for a, b in itertools.pairwise(turns):
+        f[a:b] = f_s / (2.0 * (b - a))
+    first, last = turns[0], turns[-1]
+    f[:first] = min(f_s / (2.0 * (turns[1] - first)), f_s / (2.0 * max(first, 1)))
+    f[last:] = min(f_s / (2.0 * (last - turns[-2])), f_s / (2.0 * (n - last)))
+    return f
+
+
+def band_mask(theta_cmd: ArrayLike, f_s: float, band_hz: float = BAND_HZ) -> NDArray[np.float64]:
+    """0 where the command oscillates faster than `band_hz` (`command_frequency`), 1 elsewhere.
+
+    What the monitor was not fitted on is left out of the comparison rather than fitted: a rig
+    that runs the FDI chirp on to 2 s records a second of 10-19.5 Hz motion, where the monitor
+    at the true faults errs by 2-5 times more than below 10 Hz and drove identification to twice
+    the error of the chirp alone.
+    """
+    return np.where(command_frequency(theta_cmd, f_s) > band_hz, 0.0, 1.0)
 
 
 class Fitness:

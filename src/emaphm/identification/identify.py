@@ -34,7 +34,7 @@ from ..params import EmaParams
 from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect, load_thresholds
-from .fitness import Fitness, moving_mask
+from .fitness import BAND_HZ, Fitness, band_mask, moving_mask
 from .metrics import absolute_errors, percent_error
 from .optimizers import (
     OnGeneration,
@@ -62,6 +62,8 @@ __all__ = [
 MIN_SAMPLES = 200  # a reference shorter than this (20 ms at 10 kHz) cannot show the faults
 # below this fraction of samples compared (the rest a rest in a hold), a result carries a warning
 MIN_COMPARED = 0.3
+# the comparison stops this long after the last compared sample [s] (`FaultIdentifier.prepare`)
+TAIL_MARGIN_S = 0.05
 # a diagnosis needs this much of the FDI command: on the Table 1 case (benchmarks, noise seed 7)
 # the first 0.1 s gave 31.7 %err (friction missed, a spurious eccentricity) while fitting to 3.9 %
 # NRMSE, 0.2 s 5.4 %err, 0.3 s and 0.5 s 3.4 %err
@@ -224,9 +226,12 @@ class FaultIdentifier:
     ) -> FaultIdentifier:
         """Check the measurement and set up what the search compares (`fit` calls it first).
 
-        Sets `monitor_` (the monitor under the measurement's command), `duration_` [s],
-        `reference_` (the filtered measurement on the model grid), `mask_` (the samples compared,
-        `fitness.moving_mask`), `compared_` (their fraction) and `objective_` (eq. 3 over them):
+        Sets `monitor_` (the monitor under the measurement's command), `duration_` [s] (the span
+        compared: it ends `TAIL_MARGIN_S` after the last compared sample), `reference_` (the
+        filtered measurement on the model grid over that span), `mask_` (the samples compared:
+        `fitness.moving_mask` times `fitness.band_mask`), `compared_` (their fraction of the whole
+        recording), `above_band_` (the fraction left out as faster than `fitness.BAND_HZ`) and
+        `objective_` (eq. 3 over them):
         ``objective_.of_monitor(monitor_, K, duration=duration_)`` scores fault rows K exactly as
         the search does.
         """
@@ -254,17 +259,36 @@ class FaultIdentifier:
         duration = min(span, monitor.command.duration)
         grid, theta_grid = monitor.sample_grid(duration)
         f_s = monitor.params.controller.f_s
-        reference = Comparison.from_trace(t - t[0], i_q, grid, f_s)
-        # long holds where the surface rests are left out (`moving_mask`): that current is not the faults'
+        # long holds where the surface rests are left out (`moving_mask`): that current is not the
+        # faults'; so is motion faster than the monitor was fitted on (`band_mask`)
         position = None
         if theta_u is not None:
             pos = np.asarray(theta_u, dtype=np.float64)
             if pos.shape != t.shape or not np.all(np.isfinite(pos)):
                 raise InputError("theta_u must be finite and sampled at the reference's times")
             position = np.interp(grid, t - t[0], pos)
+        in_band = band_mask(theta_grid, f_s)
+        mask = moving_mask(theta_grid, f_s, theta_u=position) * in_band
+        kept = np.flatnonzero(mask)
+        if len(kept) < MIN_SAMPLES:
+            raise InputError(
+                f"only {len(kept)} samples of the recording can be compared (at least {MIN_SAMPLES}): the rest "
+                f"is a rest in a hold or a command faster than the {BAND_HZ:g} Hz the monitor was fitted on"
+            )
+        self.compared_ = float(mask.mean())  # of the whole recording
+        self.above_band_ = float(1.0 - in_band.mean())
+        # what follows the last compared sample is not simulated: the search then costs what the
+        # compared span costs (a 2 s chirp whose second half is above the band, a long final hold).
+        # TAIL_MARGIN_S of it is kept, so that the zero-phase filter's edge stays clear of the
+        # compared samples (its transient decays as exp(-666 t): 3e-15 at 50 ms)
+        end = int(min(len(grid), kept[-1] + 1 + round(TAIL_MARGIN_S * f_s)))
+        if end < len(grid):
+            duration = float(grid[end - 1] - grid[0])
+            grid, theta_grid = monitor.sample_grid(duration)
+            mask = mask[: len(grid)]
+        reference = Comparison.from_trace(t - t[0], i_q, grid, f_s)
         self.monitor_, self.duration_, self.reference_ = monitor, duration, reference
-        self.mask_ = moving_mask(theta_grid, f_s, theta_u=position)
-        self.compared_ = float(self.mask_.mean())
+        self.mask_ = mask
         self.objective_ = Fitness(reference, self.slope_unit, self.mask_)
         return self
 
@@ -508,10 +532,16 @@ def identify(
         *(conversion or {}).get("warnings", []),
         *command_warnings(trace.t, trace.theta_cmd, monitor_model.calibration),
     ]
+    if ident.above_band_ > 0:
+        warnings.append(
+            f"{100 * ident.above_band_:.0f} % of the recording commands motion faster than the {BAND_HZ:g} Hz "
+            "the monitor was fitted on; it is left out of the comparison (docs/identification.md §3)"
+        )
     if ident.compared_ < MIN_COMPARED:
         warnings.append(
-            f"only {100 * ident.compared_:.0f} % of the recording is compared: the rest is a hold where "
-            "the surface rests, whose current does not depend on the faults; the diagnosis rests on little data"
+            f"only {100 * ident.compared_:.0f} % of the recording is compared: the rest is a hold where the surface "
+            "rests, whose current does not depend on the faults, or motion faster than the monitor was fitted on; "
+            "the diagnosis rests on little data"
         )
     limits_monitor = load_thresholds().get("monitor", "default") if thresholds is None else None
     if limits_monitor is not None and limits_monitor != monitor_model.monitor:
@@ -586,6 +616,10 @@ def identify(
         "short_check": ident.short_move_,
         # the fraction of samples the fitness compares (long holds of the command are left out)
         "samples_compared": round(ident.compared_, 4),
+        # the fraction whose command is faster than the band the monitor was fitted on (left out)
+        "samples_above_band": round(ident.above_band_, 4),
+        # the span the search simulates: it ends TAIL_MARGIN_S after the last compared sample
+        "compared_span_s": round(ident.duration_, 4),
         "slope_unit": slope_unit,
         "workers": workers,
         "optimizer_wall_time_s": round(ident.wall_time_, 3),
