@@ -320,3 +320,20 @@ def test_calibrate_uq_refuses_too_few_cases_before_the_work(tmp_path, capsys):
     code, _, err = run_cli(["calibrate-uq", "--cases", "5", "--output", str(out)], capsys)
     assert code == 2 and "--cases" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_identify_refuses_a_recording_faster_than_the_monitor_was_fitted_on(tmp_path, capsys):
+    """A 15 Hz sine: nothing within the band the monitor was fitted on, so nothing to compare."""
+    from emaphm.commands import Sine
+    from emaphm.io import write_trace
+    from emaphm.models import HighFidelityEma
+
+    trace = tmp_path / "fast.h5"
+    run = HighFidelityEma(command=Sine(amplitude=0.005, frequency=15.0, duration=0.5)).simulate(
+        [0.1, 0.1, 0, 0, 0, 0, 0, 0.5], noise=True, seed=1
+    )
+    write_trace(run, trace)
+    out = tmp_path / "r.json"
+    code, _, err = run_cli(["identify", "--reference", str(trace), "--output", str(out), *FAST], capsys)
+    assert code == 2 and "faster than the 10 Hz" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

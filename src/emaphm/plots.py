@@ -82,7 +82,8 @@ def plot_fit_curves(
     curves: Mapping[str, np.ndarray], path: Path, title: str = "", raw: np.ndarray | None = None
 ) -> Path:
     """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the LF
-    current at the estimate and their residual; samples the fitness left out (a hold) shaded, and
+    current at the estimate and their residual; samples the fitness left out (a rest in a hold,
+    motion faster than the monitor was fitted on) shaded, and
     the unfiltered measurement `raw` behind when given."""
     plt = _pyplot()
     t, m, f = curves["t"], curves["measured"], curves["fitted"]
@@ -101,7 +102,7 @@ def plot_fit_curves(
         a.grid(alpha=0.3)
         if left_out.any():
             a.fill_between(t, 0, 1, where=left_out, color="0.9", transform=a.get_xaxis_transform(),
-                           label="not compared (hold)")  # fmt: skip
+                           label="not compared")  # fmt: skip
     if title:
         fig.suptitle(title, fontsize=10)
     fig.savefig(path, dpi=110)

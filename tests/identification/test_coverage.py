@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 import emaphm
 from emaphm.calibration import default_calibration
@@ -91,10 +92,12 @@ def test_a_chirp_with_a_hold_is_covered_and_its_held_samples_are_left_out():
     trace = emaphm.simulate(emaphm.HEALTHY, command=ChirpHold(), noise=True, seed=3)
     r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
     assert not any("calibrated on" in w for w in r.warnings)  # (a 8 x 1 search need not fit)
-    # the command rests from 1.05 s; the surface too, but for slip events of the loop hunting
-    # against friction (measured: 0.64 of the samples kept by the true position, 0.70 by the
-    # measured one with its noise); the command alone would keep 0.55
-    assert 0.55 < r.settings["samples_compared"] < 0.8
+    # the command parks from 1.05 s: left out from PARK_SETTLE_S later, whatever the surface does
+    # (its slips there, the loop hunting against friction, kept 0.64-0.70 of the samples before)
+    from emaphm.identification.fitness import PARK_SETTLE_S
+
+    assert r.settings["samples_compared"] == pytest.approx((1.05 + PARK_SETTLE_S) / 2.0, abs=2e-3)
+    assert r.settings["compared_span_s"] == pytest.approx(1.05 + PARK_SETTLE_S + 0.05, abs=2e-3)
 
 
 def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are_flagged():
@@ -110,7 +113,7 @@ def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are
         metadata={},
     )
     r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
-    assert r.settings["samples_compared"] < 0.15  # the first 50 ms of the 0.5 s
+    assert r.settings["samples_compared"] < 0.15  # the first 20 ms of the 0.5 s park
     assert any("of the recording is compared" in w for w in r.warnings)
     r = emaphm.identify(
         true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False, monitor="paper"

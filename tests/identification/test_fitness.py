@@ -67,33 +67,28 @@ def test_reference_on_another_grid_is_interpolated():
         Comparison.from_trace(t_src[:100], np.zeros(100), T, F_S)
 
 
-def test_the_moving_mask_leaves_out_only_a_long_hold_where_the_surface_rests():
+def test_the_moving_mask_leaves_out_a_park_and_the_rests_of_a_staircase():
     from emaphm.commands import ChirpHold, Steps
-    from emaphm.identification.fitness import HOLD_SETTLE_S, PARK_SETTLE_S, REST_BAND, moving_mask
+    from emaphm.identification.fitness import PARK_SETTLE_S, REST_BAND, moving_mask
 
     f_s = 1e4
     t = np.arange(20001) / f_s
-    hold = ChirpHold()(t)  # the chirp to 1 s, back to zero by 1.05 s, then held
-    m = moving_mask(hold, f_s)
-    assert np.all(m[t <= 1.05 + 0.05] == 1.0) and np.all(m[t > 1.05 + 0.05 + 2e-4] == 0.0)
-    assert np.all(moving_mask(Chirp()(t), f_s) == 1.0)  # a chirp never holds
-    # with the surface position: left out only where it rests as well
-    at_rest = 0.3 * REST_BAND * np.sin(2 * np.pi * 50 * t)  # noise within the band
-    creeping = at_rest + np.where(t > 1.2, 100 * REST_BAND * (t - 1.2), 0.0)  # 5 bands per 50 ms
-    # in a park (a hold longer than LONG_HOLD_S) a measured rest is seen after PARK_SETTLE_S
-    parked = moving_mask(hold, f_s, theta_u=at_rest)
+    hold = ChirpHold()(t)  # the chirp to 1 s, back to zero by 1.05 s, then held (a park)
     stop = 1.05 + PARK_SETTLE_S
-    assert np.all(parked[t <= stop] == 1.0) and np.all(parked[t > stop + 2e-4] == 0.0)
-    np.testing.assert_array_equal(moving_mask(hold, f_s, theta_u=at_rest, park_settle=HOLD_SETTLE_S), m)
-    kept = moving_mask(hold, f_s, theta_u=creeping)
-    assert np.all(kept[t > 1.3] == 1.0) and np.all(kept[(t > 1.11) & (t < 1.2)] == 0.0)
-    # steps of 0.2 s: without a position, dwells shorter than LONG_HOLD_S stay whole (the surface
-    # hunts through them); with it, a dwell is cut only where the surface rests
+    at_rest = 0.3 * REST_BAND * np.sin(2 * np.pi * 50 * t)  # noise within the band
+    slipping = at_rest + np.where(t > 1.2, 100 * REST_BAND * (t - 1.2), 0.0)  # 5 bands per 50 ms
+    for position in (None, at_rest, slipping):  # a park is left out whatever the surface does
+        m = moving_mask(hold, f_s, theta_u=position)
+        assert np.all(m[t <= stop] == 1.0) and np.all(m[t > stop + 2e-4] == 0.0)
+    assert np.all(moving_mask(Chirp()(t), f_s) == 1.0)  # a chirp never holds
+    # steps of 0.2 s: without a position the dwells stay whole (the surface hunts through them);
+    # with it, a dwell is cut only where the surface rests, 50 ms after the step
     steps = Steps(dwell=0.2)(t)
     assert np.all(moving_mask(steps, f_s) == 1.0)
     hunting = 3 * REST_BAND * np.sin(2 * np.pi * 20 * t)
     assert np.all(moving_mask(steps, f_s, theta_u=hunting) == 1.0)
-    assert 0.2 < moving_mask(steps, f_s, theta_u=np.zeros_like(t)).mean() < 0.3
+    resting = moving_mask(steps, f_s, theta_u=np.zeros_like(t))
+    assert 0.2 < resting.mean() < 0.3 and np.all(resting[(t > 0.2) & (t <= 0.25)] == 1.0)
 
 
 def test_a_masked_fitness_ignores_the_left_out_samples():

@@ -45,8 +45,9 @@ def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, t
     err = absolute_errors(ident.faults_, truth)
     assert np.all(np.delete(err, 6) < tol), err
     pop, gen = small_polish
-    # the GA, its polish, the final check of the shorts (8), and a second polish if a candidate fits better
-    assert ident.run_.evaluations <= 16 * 6 + 2 * pop * (gen + 1) + 8
+    # the GA, the polish of its best point and of its runner-up, the final check of the shorts (8),
+    # and one more polish if a candidate fits better
+    assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8
 
 
 def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
@@ -158,6 +159,13 @@ def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitte
         Fitness(whole, "s", mask).of_monitor(monitor, K),
         rtol=1e-9,
     )
+    # the figures show the whole recording: the LF current up to the span simulated, NaN after it
+    ident = FaultIdentifier(pop_size=8, generations=1, local_polish=False, monitor=MonitorEma())
+    curves = ident.fit(trace.t, trace.i_q, recorded, trace.theta_u).curves()
+    assert curves["t"][-1] == pytest.approx(2.0) and len(curves["measured"]) == len(curves["t"])
+    inside = curves["t"] <= ident.duration_ + 1e-9
+    assert np.all(np.isfinite(curves["fitted"][inside])) and np.all(np.isnan(curves["fitted"][~inside]))
+    assert np.all(curves["compared"][~inside] == 0.0) and curves["compared"][inside].mean() > 0.9
     # a command entirely above the band leaves nothing to compare: refused, not fitted
     fast = SampledCommand(trace.t, 0.005 * np.sin(2 * np.pi * 15 * trace.t))
     with pytest.raises(InputError, match="samples of the recording can be compared"):

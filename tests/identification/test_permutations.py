@@ -75,3 +75,45 @@ def test_the_phase_is_moved_off_a_bound_of_the_box_without_changing_the_faults()
         assert 0.25 <= out.x[6] < 0.75 and (out.f, out.evaluations, out.history) == (0.5, 7, [1.0])
         np.testing.assert_allclose(search_to_faults(out.x[None]), search_to_faults(x[None]), atol=1e-12)
         np.testing.assert_array_equal(np.delete(out.x, 6), np.delete(x, 6))
+
+
+# two basins in the search box: a shallow one at A (floor 0.05) and the deep one at B (floor 0)
+A = np.array([0.6, 0.4, 0.3, 0.3, 0.3, 0.2, 0.4, 0.5])
+B = np.array([0.5, 0.45, 0.2, 0.4, 0.2, 0.25, 0.45, 0.5])
+
+
+def two_basins(X):
+    X = np.atleast_2d(X)
+    return np.minimum(np.sum((X - A) ** 2, axis=1) * 50 + 0.05, np.sum((X - B) ** 2, axis=1) * 50)
+
+
+def test_the_runner_up_is_the_best_member_of_another_basin():
+    from emaphm.identification.identify import runner_up
+
+    close = A + 0.01  # the same basin: within RUNNER_UP_DISTANCE in every fault
+    same_phase = A.copy()
+    same_phase[6] = A[6] + 0.5  # x7 and x7 + 0.5 give the same k7: not another candidate
+    far_good, far_bad = B + 0.02, B + 0.1
+    population = np.array([A, close, same_phase, far_bad, far_good])
+    run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
+    second = runner_up(run)
+    assert second is not None
+    np.testing.assert_array_equal(second.x, far_good)
+    assert (
+        runner_up(OptimizerRun(A.copy(), 0.05, 10, [1.0], population[:3], two_basins(population[:3]))) is None
+    )
+    assert runner_up(OptimizerRun(A.copy(), 0.05, 10, [1.0])) is None  # no population (a polish's run)
+
+
+def test_polishing_the_runner_up_escapes_a_neighbouring_basin():
+    from emaphm.identification.identify import polish_two
+
+    population = np.array([A, A - 0.01, B + 0.05])
+    run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
+    out, won = polish_two(two_basins, run, seed=1)
+    assert won and out.f < 1e-4 and np.max(np.abs(out.x - B)) < 0.01
+    assert out.evaluations > 10 + 32 and out.history[0] == 1.0
+    # when the best point's basin is the deep one, it stays
+    swapped = OptimizerRun(B.copy(), 0.0, 10, [0.0], population[::-1], two_basins(population[::-1]))
+    kept, won = polish_two(two_basins, swapped, seed=1)
+    assert not won and kept.f == 0.0

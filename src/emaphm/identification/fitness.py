@@ -48,18 +48,18 @@ __all__ = [
 
 SLOPE_UNITS = {"s": 1.0, "ms": 1e-3}  # the slope in A per this unit of time
 
-# a hold of the command counts for this long after the command stops (the surface settles)
+# in a short hold (a staircase's dwell), a rest of the surface counts after this long [s]
 HOLD_SETTLE_S = 0.05
 
-
-# without a measured position, only holds of the command longer than this count as rests
+# a hold longer than this [s] in all is a park (`moving_mask`), not a staircase's dwell
 LONG_HOLD_S = 0.5
 
-# in such a hold (the surface parked) the rest is seen after this [s], with a measured position:
-# on the chirp followed by a hold, 8 random cases x 2 seeds, %err median / p90 / max 4.62 / 7.20 /
-# 9.57 with `HOLD_SETTLE_S` and 2.77 / 5.3 / 6.12 with 20 ms. In a staircase's 0.2 s dwells the
-# rests after a step carry the breakaway friction: a 10 or 20 ms window there made one of 12 runs
-# 13-18 %err, so the dwells keep `HOLD_SETTLE_S` (docs/identification.md §3)
+# such a hold (a park) is left out from this long after the command stops [s], whatever the surface
+# does (`moving_mask`): on the chirp followed by a hold, 8 random cases x 2 seeds, %err median / p90 /
+# max 4.62 / 7.20 / 9.57 with the rests only, after `HOLD_SETTLE_S`, and 2.77 / 5.30 / 6.12 with the
+# rests after 20 ms; but on 40 cases the slips kept in the parks drove 9 of 80 runs above 10 %err
+# (BENCHMARKS.md). A staircase's 0.2 s dwells keep `HOLD_SETTLE_S`: its rests after a step carry the
+# breakaway friction, and a 10 or 20 ms window there made one of 12 runs 13-18 %err
 PARK_SETTLE_S = 0.02
 
 # the surface counts as at rest while its measured position stays within this band [rad]: 10 LSB
@@ -82,25 +82,26 @@ def moving_mask(
     theta_u: ArrayLike | None = None,
     park_settle: float = PARK_SETTLE_S,
 ) -> NDArray[np.float64]:
-    """0 on the samples of a hold where the surface is stuck, 1 everywhere else.
+    """0 on the samples of a hold where the surface is stuck or parked, 1 everywhere else.
 
-    A sample is left out when the command has not moved for more than `settle` [s] and the
-    measured surface position `theta_u` [rad] has stayed within `REST_BAND` over that time too.
-    In a hold longer than `LONG_HOLD_S` in all (the surface parked, not a staircase's dwell),
-    `park_settle` replaces `settle`: the rest is seen sooner. Without `theta_u` the rest of the
-    surface is unknown: then only the holds longer than `LONG_HOLD_S` are taken as rests (after
-    `settle`), so that the 0.2 s dwells of a staircase, where the surface keeps hunting, stay
-    whole.
+    In a hold longer than `LONG_HOLD_S` in all (a park, not a staircase's dwell) every sample
+    after `park_settle` [s] is left out, whatever the surface does. In a shorter hold a sample is
+    left out when the command has not moved for more than `settle` [s] and the measured surface
+    position `theta_u` [rad] has stayed within `REST_BAND` over that time too; without `theta_u`
+    those dwells stay whole (the surface hunts through a staircase's 0.2 s dwells).
 
     Where the surface rests, it sits wherever stick-slip left it, and the position loop's
     integrator ramps the current against that small error: the held current depends on the
     sticking point, not on the faults. On the chirp followed by a hold it differed by 30-37 mA RMS
     between the twin and the monitor at the true faults, against 16 mA over the chirp, and it drove
-    identification to 25-40 %err (monitor-model.md §5). After a step the surface keeps moving
-    (the loop hunts against friction and backlash) and those samples stay: they carry the faults.
-    The stop that begins a park is as chaotic (it follows the chirp's rattling end): its first
-    50 ms held 40-70 % of eq. (3) at the true faults on 5 random cases, hence `park_settle`. A
-    command that never holds keeps every sample.
+    identification to 25-40 %err (monitor-model.md §5). In a park the surface also slips now and
+    then, when the integrator has wound up past the breakaway friction: the timing of those slips
+    is chaotic, and on 3 of 40 random cases the 0.1 s of them held 74-98 % of eq. (3) at the true
+    faults. The stop that begins a park follows the chirp's rattling end and is as chaotic (its
+    first 50 ms held 40-70 % of eq. (3) at the true faults on 5 cases), hence the short
+    `park_settle`. After a step of a staircase the surface keeps moving (the loop hunts against
+    friction and backlash) and those samples stay: they carry the faults. A command that never
+    holds keeps every sample.
     """
     theta = np.asarray(theta_cmd, dtype=np.float64)
     n = len(theta)
@@ -112,16 +113,12 @@ def moving_mask(
     last_move = np.maximum.accumulate(np.where(still, 0, idx))  # the last sample the command moved
     next_move = np.minimum.accumulate(np.where(still, n, idx)[::-1])[::-1]  # the next sample it moves
     parked = (next_move - last_move) / f_s > LONG_HOLD_S
-    held = still & (idx - last_move > window)
-    if theta_u is None:
-        held &= parked
-    else:
+    held = still & parked & (idx - last_move > max(round(park_settle * f_s), 1))
+    if theta_u is not None:
         pos = np.asarray(theta_u, dtype=np.float64)
         if pos.shape != theta.shape:
             raise ValueError(f"theta_u has shape {pos.shape}, theta_cmd {theta.shape}")
-        held &= _trailing_spread(pos, window) <= REST_BAND
-        short = max(round(park_settle * f_s), 1)
-        held |= still & parked & (idx - last_move > short) & (_trailing_spread(pos, short) <= REST_BAND)
+        held |= still & (idx - last_move > window) & (_trailing_spread(pos, window) <= REST_BAND)
     return np.where(held, 0.0, 1.0)
 
 

@@ -131,12 +131,16 @@ class _LoopState:
 
 @dataclass(frozen=True)
 class OptimizerRun:
-    """The outcome of one optimiser run: best point, value, evaluations, best value per generation."""
+    """The outcome of one optimiser run: best point, value, evaluations, best value per generation;
+    for a global search also its final population (points in the box and their values), from which
+    `identify` polishes a second, distinct candidate."""
 
     x: NDArray[np.float64]
     f: float
     evaluations: int
     history: list[float]
+    population: NDArray[np.float64] | None = None
+    population_f: NDArray[np.float64] | None = None
 
 
 class BatchProblem(Problem):  # type: ignore[misc]
@@ -214,10 +218,23 @@ def minimize_batch(
         if stagnation is None
         else stagnation.termination(generations)
     )
+    x, f, history, _ = _minimize(problem, algorithm, termination, generations, seed, on_generation)
+    return x, f, history
+
+
+def _minimize(
+    problem: BatchProblem,
+    algorithm: Any,
+    termination: Termination,
+    generations: int,
+    seed: int,
+    on_generation: OnGeneration | None,
+) -> tuple[NDArray[np.float64], float, list[float], Any]:
+    """pymoo's `minimize` with a `GenerationLog`: best point (clipped), value, history, result."""
     log = GenerationLog(generations, on_generation)
     res = minimize(problem, algorithm, termination, seed=seed, verbose=False, callback=log)
     x = np.clip(np.atleast_2d(res.X)[0], problem.xl, problem.xu)
-    return x, float(np.atleast_1d(res.F)[0]), log.history
+    return x, float(np.atleast_1d(res.F)[0]), log.history, res
 
 
 def check_optimizer(name: str) -> str:
@@ -282,11 +299,13 @@ def run_optimizer(
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     if name == "gwo":
         return _grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
-    x, f, history = minimize_batch(
-        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng), generations,
-        seed=seed, stagnation=stop, on_generation=on_generation,
+    x, f, history, res = _minimize(
+        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng), stop.termination(generations),
+        generations, seed, on_generation,
     )  # fmt: skip
-    return OptimizerRun(x, f, problem.evaluations, history)
+    pop = res.pop
+    return OptimizerRun(x, f, problem.evaluations, history, np.clip(pop.get("X"), problem.xl, problem.xu),
+                        np.asarray(pop.get("F"), dtype=np.float64).reshape(-1))  # fmt: skip
 
 
 def _grey_wolf(
@@ -326,7 +345,7 @@ def _grey_wolf(
         stop.update(_LoopState(gen, float(leader_f[0])))
         if stop.has_terminated():
             break
-    return OptimizerRun(leaders[0].copy(), float(leader_f[0]), problem.evaluations, log.history)
+    return OptimizerRun(leaders[0].copy(), float(leader_f[0]), problem.evaluations, log.history, X, F)
 
 
 def polish(
