@@ -1,5 +1,6 @@
 """The %err metric against the paper's Table 1 (an independent reference: the published numbers)."""
 
+import numpy as np
 import pytest
 
 from emaphm import InputError
@@ -56,3 +57,12 @@ def test_eccentricity_phase_error_is_taken_on_the_circle(form):
     half = percent_error([0, 0, 0, 0, 0, 0.3, 0.51, 0.5], truth, form=form)
     assert half == pytest.approx(percent_error([0, 0, 0, 0, 0, 0.3, 0.51 - 1e-12, 0.5], truth, form=form))
     assert half >= across
+
+
+def test_wrap_phase_wraps_an_array_as_it_wraps_each_value():
+    from emaphm.identification.metrics import wrap_phase
+
+    d = np.array([-0.9, -0.5, -0.2, 0.0, 0.3, 0.5, 0.75, 1.4])
+    np.testing.assert_allclose(wrap_phase(d), [wrap_phase(float(v)) for v in d], atol=1e-15)
+    np.testing.assert_allclose(wrap_phase(d), [0.1, -0.5, -0.2, 0.0, 0.3, -0.5, -0.25, 0.4], atol=1e-12)
+    assert isinstance(wrap_phase(0.7), float)

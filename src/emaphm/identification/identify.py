@@ -35,7 +35,7 @@ from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect, load_thresholds
 from .fitness import BAND_HZ, Fitness, band_mask, moving_mask
-from .metrics import absolute_errors, percent_error
+from .metrics import absolute_errors, percent_error, wrap_phase
 from .optimizers import (
     OnGeneration,
     OptimizerRun,
@@ -421,7 +421,7 @@ def runner_up(run: OptimizerRun, distance: float = RUNNER_UP_DISTANCE) -> Optimi
     K = search_to_faults(run.population)
     best = search_to_faults(run.x[None, :])[0]
     d = np.abs(K - best)
-    d[:, 6] = np.abs((d[:, 6] + 0.5) % 1.0 - 0.5)
+    d[:, 6] = np.abs(wrap_phase(d[:, 6]))
     f = np.where(np.isfinite(run.population_f), run.population_f, np.inf)
     far = np.flatnonzero((d.max(axis=1) > distance) & np.isfinite(f))
     if not len(far):

@@ -20,7 +20,7 @@ unaffected (their phase errors are below 0.5).
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -47,9 +47,14 @@ def percent_error(
     raise InputError(f"unknown %err form {form!r}; use 'table1' or 'printed'")
 
 
-def wrap_phase(dk7: float) -> float:
-    """A difference of k7 (a phase in turns) wrapped to [−0.5, 0.5)."""
-    return float((dk7 + 0.5) % 1.0 - 0.5)
+@overload
+def wrap_phase(dk7: float) -> float: ...
+@overload
+def wrap_phase(dk7: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def wrap_phase(dk7: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
+    """A difference of k7 (a phase in turns) wrapped to [−0.5, 0.5); elementwise for an array."""
+    wrapped = (np.asarray(dk7, dtype=np.float64) + 0.5) % 1.0 - 0.5
+    return wrapped if np.ndim(dk7) else float(wrapped)
 
 
 def absolute_errors(estimate: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:
