@@ -125,7 +125,8 @@ def moving_mask(
 # the fastest command the monitor is compared on [Hz]: the FDI chirp's top frequency (DESIGN §6),
 # the fastest motion the monitor was fitted on. Above it the monitor is far from the twin: on the
 # chirp run on to 19.5 Hz its error at the true faults (150 Hz filtered, per quarter second, 12
-# random cases) grows from 4-9 mA below 5 Hz to 10-25 mA above 10 Hz, where the surface sticks
+# random cases, `benchmarks/monitor_error_at_truth.py --command chirp-2s`) grows from 4-9 mA below
+# 5 Hz to 10-25 mA above 10 Hz, where the surface sticks
 # and the motor rattles in the backlash; fitted whole, that trace gave 6.2 %err median, and 2.7
 # with the samples above 10 Hz left out (BENCHMARKS.md, "Other commands").
 BAND_HZ = 10.0
