@@ -24,6 +24,7 @@ import numpy as np
 import emaphm
 from emaphm.faults import FAULT_NAMES, HEALTHY
 from emaphm.identification.detection import DETECTABLE, detect
+from emaphm.identification.fitness import ERROR_CORNER_HZ
 from emaphm.identification.identify import identify
 
 
@@ -84,6 +85,7 @@ def main() -> None:
             "monitor": "default",  # identify() warns when another monitor uses these thresholds
             "rule": "1.25 x the largest healthy departure + 0.005 (k1..k6 from 0, k8 from 0.5)",
             "optimizer": args.optimizer,
+            "error_corner_hz": ERROR_CORNER_HZ,  # the eq. 3 frequency weights the identifications used
             "threshold_seeds": [1000, 1000 + args.runs - 1],
             "false_alarm_seeds": [2000, 2000 + args.runs - 1],
             "false_alarm_runs": false_runs,

@@ -2,6 +2,8 @@
 
     python benchmarks/monitor_error_at_truth.py [--command chirp-2s] [--cases 12] [--window 0.25]
                                                 [--case-seed 2611] [--only 0,12] [--floor]
+    python benchmarks/monitor_error_at_truth.py --by-frequency
+
 
 For each of bench_multifault's random cases (its own seed 2611, noise off), per window of the
 command: the RMS of (filtered HF current − filtered monitor current at the true faults) against
@@ -9,6 +11,12 @@ the RMS of the filtered HF current (mA, over the whole window), and the share of
 the window, over the samples the identification compares (`FaultIdentifier.prepare`: holds at
 rest, parks and motion above the band left out). --floor adds the twin's own chaotic floor: the
 NRMSE of the HF current against the HF with friction k1 + 1e-5.
+
+--by-frequency measures where `fitness.ERROR_CORNER_HZ` comes from: on the calibration's fitting
+scenarios under the FDI chirp (`calibrate.FIT_SCENARIOS`, none of the benchmark's cases), the RMS
+of the monitor's error at the true faults (noise off, filtered) per band of the command's local
+frequency (`fitness.command_frequency`), and the corner f_c of σ²(f) = σ0²·(1 + (f/f_c)²) fitted
+to it (least squares on the variances relative to each, so each band counts alike).
 """
 
 from __future__ import annotations
@@ -21,7 +29,8 @@ import numpy as np
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
+from emaphm.identification.calibrate import CALIBRATION_COMMANDS, FIT_SCENARIOS
+from emaphm.identification.fitness import ERROR_CORNER_HZ, command_frequency
 from emaphm.identification.identify import FaultIdentifier
 from emaphm.models import HighFidelityEma, MonitorEma
 
@@ -34,7 +43,15 @@ def main() -> None:
     parser.add_argument("--window", type=float, default=0.25, help="window length [s]")
     parser.add_argument("--only", default=None, help="comma-separated case numbers")
     parser.add_argument("--floor", action="store_true", help="also HF against HF with k1 + 1e-5")
+    parser.add_argument(
+        "--by-frequency",
+        action="store_true",
+        help="the error per frequency band on the calibration's scenarios",
+    )
     args = parser.parse_args()
+    if args.by_frequency:
+        by_frequency()
+        return
     command = CALIBRATION_COMMANDS[args.command]
     hf, monitor = HighFidelityEma(None, command), MonitorEma(None, command)
     cases = random_faults(args.cases, args.case_seed)
@@ -68,6 +85,44 @@ def main() -> None:
             k2[0] += 1e-5
             line += f" | floor {100 * float(whole.nrmse(hf.simulate(k2, noise=False).i_q)):.2f} %"
         print(line, flush=True)
+
+
+def by_frequency() -> None:
+    from scipy.optimize import curve_fit
+
+    command = CALIBRATION_COMMANDS["chirp"]
+    hf, monitor = HighFidelityEma(None, command), MonitorEma(None, command)
+    f_s = hf.params.controller.f_s
+    edges = np.array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0 + 1e-9])
+    sq, ref_sq, n = np.zeros(len(edges) - 1), np.zeros(len(edges) - 1), np.zeros(len(edges) - 1)
+    scenarios = [sc for sc in FIT_SCENARIOS if sc.command == "chirp"]
+    for sc in scenarios:
+        k = np.asarray(sc.faults)
+        trace = hf.simulate(k, noise=False)
+        whole = Comparison.from_signal(trace.t, trace.i_q, f_s)
+        error = whole.reference - whole.filtered(monitor.simulate(k).i_q)
+        f = command_frequency(monitor.sample_grid()[1], f_s)[: len(error)]
+        band = np.digitize(f, edges) - 1
+        np.add.at(sq, band, error**2)
+        np.add.at(ref_sq, band, whole.reference**2)
+        np.add.at(n, band, 1.0)
+    print(
+        f"the monitor at the true faults, {len(scenarios)} fitting scenarios of the calibration, FDI chirp, noise off"
+    )
+    print(f"{'band [Hz]':>10} {'samples':>8} {'error RMS [mA]':>15} {'HF RMS [mA]':>12}")
+    used = n > 0
+    for a, b, m, e, r in zip(edges[:-1], edges[1:], n, sq, ref_sq, strict=True):
+        if m:
+            print(
+                f"{a:4.0f}-{b:<5.0f} {int(m):>8} {1e3 * np.sqrt(e / m):>15.1f} {1e3 * np.sqrt(r / m):>12.1f}"
+            )
+    f_mid = 0.5 * (edges[:-1] + edges[1:])[used]
+    var = (sq / np.maximum(n, 1))[used]
+    (s0, corner), _ = curve_fit(
+        lambda f, a, c: a * (1 + (f / c) ** 2), f_mid, var, p0=(var[0], 3.0), sigma=var
+    )
+    print(f"sigma^2(f) = s0^2 (1 + (f/f_c)^2): s0 {1e3 * np.sqrt(s0):.1f} mA, f_c {corner:.2f} Hz "
+          f"(fitness.ERROR_CORNER_HZ = {ERROR_CORNER_HZ:g})")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -278,6 +278,8 @@ def _write_bad_traces(d):
         (["identify", "--reference", "few.csv"], "at least 200"),
         (["identify", "--reference", "nocmd.csv"], "theta_cmd"),
         (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--output", "r.txt"], "--output"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--error-corner", "-3"], "--error-corner"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--error-corner", "fast"], "--error-corner"),
     ],
 )
 def test_identify_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, monkeypatch, args, reason):

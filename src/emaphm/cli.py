@@ -11,6 +11,7 @@ command imports what it needs.
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
@@ -166,6 +167,13 @@ def identify(
         Path | None,
         typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
     ] = None,
+    error_corner: Annotated[
+        str,
+        typer.Option(
+            help="Weight eq. 3 by 1/(1 + (f/F)^2) of the command's frequency f: F in Hz, 'auto' (the "
+            "default monitor's measured corner; none with --monitor paper) or 'off' (the paper's eq. 3)."
+        ),
+    ] = "auto",
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current.
 
@@ -186,6 +194,7 @@ def identify(
         raise InputError(f"unknown --uncertainty {uncertainty!r}; use one of {', '.join(UQ_METHOD_NAMES)}")
     check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     check_seed(seed)
+    corner = _error_corner(error_corner)
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
     if reference is not None and map_file is None:
         check_trace_path(reference, for_writing=False)
@@ -214,6 +223,7 @@ def identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
             generations=generations, local_polish=polish, calibration=calibration, monitor=monitor,
             uncertainty=uncertainty, uq_calibration=uq_calibration, params=params, channel_map=map_file,
+            error_corner_hz=corner,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
             ),
@@ -245,6 +255,19 @@ def identify(
         _print_identification(data)
     if data["verdict"] != "fits":
         raise typer.Exit(3)  # ran, but no diagnosis: scripts must not read it as one
+
+
+def _error_corner(text: str) -> float | str | None:
+    """--error-corner: 'auto', 'off' or a frequency > 0 [Hz]."""
+    if text in ("auto", "off"):
+        return None if text == "off" else "auto"
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"--error-corner must be 'auto', 'off' or a frequency > 0 Hz, got {text!r}")
+    return value
 
 
 def _print_identification(data: dict[str, Any]) -> None:

@@ -177,3 +177,28 @@ def test_the_band_mask_leaves_out_only_motion_faster_than_the_fdi_chirp():
     first = t[np.argmin(m)]
     assert 0.95 < first < 1.08 and np.all(m[t > first] == 0.0) and np.all(m[t < first] == 1.0)
     assert np.all(band_mask(0.005 * np.sin(2 * np.pi * 15 * t), f_s) == 0.0)
+
+
+def test_error_weights_follow_the_command_frequency_and_the_emphasis_scales_eq3():
+    from emaphm.identification.fitness import error_weights
+
+    f_s = 1e4
+    t = np.arange(10001) / f_s
+    # a 3 Hz sine at a 3 Hz corner: 1/2; a hold or a ramp (no reversal): 1; no corner: 1
+    np.testing.assert_allclose(error_weights(0.05 * np.sin(2 * np.pi * 3 * t), f_s, 3.0), 0.5, rtol=0.02)
+    np.testing.assert_array_equal(error_weights(np.zeros_like(t), f_s), 1.0)
+    np.testing.assert_array_equal(error_weights(0.01 * t, f_s), 1.0)
+    np.testing.assert_array_equal(error_weights(np.sin(40 * t), f_s, None), 1.0)
+    with pytest.raises(InputError, match="corner"):
+        error_weights(np.sin(40 * t), f_s, 0.0)
+    # the emphasis multiplies eq. 3's weights: a difference where it is 0 costs nothing
+    current = 0.3 * np.sin(2 * np.pi * 4 * T)
+    ref = Comparison.from_signal(T, current, F_S)
+    emphasis = np.where(T < 0.25, 1.0, 0.0)
+    np.testing.assert_array_equal(Fitness(ref, emphasis=emphasis).weights, Fitness(ref).weights * emphasis)
+    worse = current + np.where(T >= 0.3, 0.3, 0.0)
+    assert Fitness(ref, emphasis=emphasis)(worse) < 1e-3 * Fitness(ref)(worse)
+    with pytest.raises(ValueError, match="emphasis"):
+        Fitness(ref, emphasis=emphasis[:-1])
+    with pytest.raises(ValueError, match="emphasis"):
+        Fitness(ref, emphasis=-emphasis)

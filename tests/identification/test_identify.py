@@ -101,7 +101,13 @@ def test_identify_records_what_it_did():
     # the shipped thresholds, applied to the estimate, when the monitor explains the measurement;
     # a 16 x 3 search without polish may not (then the verdict says so and nothing is reported)
     assert data["verdict"] == ("fits" if data["fit_nrmse"] <= 0.5 else "does not fit")
-    assert data["detected"] == (detect(res.estimate) if data["verdict"] == "fits" else [])
+    # by the intervals' verdicts when there are intervals, by the point rule when there are none
+    if data["verdict"] != "fits":
+        assert data["detected"] == []
+    elif res.uncertainty is None:
+        assert data["detected"] == detect(res.estimate)
+    else:
+        assert data["detected"] == [n for n, v in res.fault_verdicts.items() if v == "present"]
 
 
 def test_identify_bad_input(tmp_path):
@@ -131,7 +137,7 @@ def test_phase_map_wraps_and_keeps_every_phase_away_from_the_bounds():
 def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitted():
     """The chirp run on to 2 s: the second above 10 Hz is left out, and not simulated at all."""
     from emaphm.commands import Chirp, SampledCommand
-    from emaphm.identification.fitness import Fitness
+    from emaphm.identification.fitness import Fitness, error_weights
     from emaphm.identification.identify import TAIL_MARGIN_S, FaultIdentifier
     from emaphm.identification.signals import Comparison
     from emaphm.models import HighFidelityEma, MonitorEma
@@ -149,14 +155,14 @@ def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitte
     # the same eq. (3) as over the whole recording with the same samples compared: the filter's
     # edge at the cut stays clear of them
     monitor, f_s = ident.monitor_, ident.monitor_.params.controller.f_s
-    grid, _ = monitor.sample_grid(None)
+    grid, theta = monitor.sample_grid(None)
     whole = Comparison.from_trace(trace.t, trace.i_q, grid, f_s)
     mask = np.zeros(len(grid))
     mask[: len(ident.mask_)] = ident.mask_
     K = np.array([k, 0.8 * k, np.full(8, 0.1)])
     np.testing.assert_allclose(
         ident.objective_.of_monitor(monitor, K, duration=ident.duration_),
-        Fitness(whole, "s", mask).of_monitor(monitor, K),
+        Fitness(whole, "s", mask, error_weights(theta, f_s)).of_monitor(monitor, K),
         rtol=1e-9,
     )
     # the figures show the whole recording: the LF current up to the span simulated, NaN after it
@@ -170,3 +176,34 @@ def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitte
     fast = SampledCommand(trace.t, 0.005 * np.sin(2 * np.pi * 15 * trace.t))
     with pytest.raises(InputError, match="samples of the recording can be compared"):
         FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, fast)
+
+
+def test_the_fitness_weights_motion_by_the_monitors_error_growing_with_frequency():
+    """The default monitor's eq. 3 counts the chirp's fast end less (`fitness.error_weights`); the
+    paper's monitor keeps the paper's eq. 3; the corner is recorded and a bad one refused."""
+    from emaphm.commands import SampledCommand
+    from emaphm.identification.fitness import ERROR_CORNER_HZ, Fitness, error_weights
+    from emaphm.identification.identify import FaultIdentifier, resolve_error_corner
+    from emaphm.models import MonitorEma
+
+    trace = emaphm.simulate([0.1, 0, 0.2, 0, 0, 0, 0, 0.5], duration=1.0)
+    command = SampledCommand(trace.t, trace.theta_cmd)
+    plain = FaultIdentifier(monitor=MonitorEma(), error_corner_hz=None).prepare(trace.t, trace.i_q, command)
+    auto = FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, command)
+    assert plain.error_corner_hz_ is None and auto.error_corner_hz_ == ERROR_CORNER_HZ
+    _, theta = auto.monitor_.sample_grid(auto.duration_)
+    emphasis = error_weights(theta, auto.monitor_.params.controller.f_s)
+    np.testing.assert_allclose(auto.objective_.weights, plain.objective_.weights * emphasis, rtol=1e-12)
+    # the chirp's 2 Hz start counts about seven times its 10 Hz end
+    t = auto.reference_.t
+    assert emphasis[t < 0.2].min() > 5 * emphasis[t > 0.95].max()
+    assert np.all(np.diff(emphasis[(t > 0.1) & (t < 0.99)]) <= 1e-12)  # the sweep only speeds up
+    paper = FaultIdentifier(monitor=MonitorEma(monitor="paper")).prepare(trace.t, trace.i_q, command)
+    assert paper.error_corner_hz_ is None
+    np.testing.assert_array_equal(paper.objective_.weights, Fitness(paper.reference_).weights)
+    assert resolve_error_corner(2.5, "paper") == 2.5
+    for bad in (0.0, -1.0, float("nan"), "fast"):
+        with pytest.raises(InputError, match="error corner"):
+            resolve_error_corner(bad, "default")
+    with pytest.raises(InputError, match="error corner"):
+        identify([0] * 7 + [0.5], error_corner_hz=-2.0)

@@ -89,6 +89,8 @@ def calibrate_uq(
 
     `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
     """
+    from .identify import resolve_error_corner
+
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
         raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
@@ -107,6 +109,8 @@ def calibrate_uq(
             "created": lf.record.get("created"),
             "params_hash": lf.params_hash,
         },
+        # the eq. 3 frequency weights the identifications used (`fitness.error_weights`)
+        "error_corner_hz": resolve_error_corner("auto", lf.monitor),
         "cases": cases,
         "seed": seed,
         "absent": UQ_ABSENT,

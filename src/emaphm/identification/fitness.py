@@ -34,6 +34,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BAND_HZ",
+    "ERROR_CORNER_HZ",
     "HOLD_SETTLE_S",
     "LONG_HOLD_S",
     "PARK_SETTLE_S",
@@ -43,6 +44,7 @@ __all__ = [
     "Fitness",
     "band_mask",
     "command_frequency",
+    "error_weights",
     "moving_mask",
 ]
 
@@ -131,6 +133,15 @@ def moving_mask(
 # with the samples above 10 Hz left out (BENCHMARKS.md, "Other commands").
 BAND_HZ = 10.0
 
+# The monitor's error at the true faults grows with the command's frequency, more than the signal:
+# on the calibration's fitting scenarios under the FDI chirp (24 actuators, noise off, 150 Hz
+# filtered) its RMS is 5.7 mA at 2-3 Hz and 10-12 mA at 7-10 Hz, while the current itself falls
+# from 390 to 230 mA (`python benchmarks/monitor_error_at_truth.py --by-frequency`). Least squares
+# weighted by the inverse of that error's variance, σ²(f) ∝ 1 + (f/f_c)², is the generalised least
+# squares of a model error that grows with f (`error_weights`); f_c = 2.38 Hz is the corner of that
+# variance fitted there. Checked on cases of their own (BENCHMARKS.md, "Frequency weights").
+ERROR_CORNER_HZ = 2.4
+
 # a turn of the command counts as a reversal once it has come back this fraction of its peak
 # excursion (so that a recorded command's quantisation or noise makes no reversals)
 REVERSAL_FRACTION = 0.01
@@ -192,13 +203,38 @@ def band_mask(theta_cmd: ArrayLike, f_s: float, band_hz: float = BAND_HZ) -> NDA
     return np.where(command_frequency(theta_cmd, f_s) > band_hz, 0.0, 1.0)
 
 
+def error_weights(
+    theta_cmd: ArrayLike, f_s: float, corner_hz: float | None = ERROR_CORNER_HZ
+) -> NDArray[np.float64]:
+    """Per-sample weights 1/(1 + (f/f_c)²) for the monitor's error growing with the command's local
+    frequency f (`command_frequency`; f_c = `corner_hz`, None: all 1).
+
+    Multiplied into eq. (3) (`Fitness(emphasis=...)`), they make it the weighted least squares of
+    a model error whose variance grows as 1 + (f/f_c)² (`ERROR_CORNER_HZ`): the motion where the
+    monitor is known to be less faithful pulls the estimate less. Holds and ramps (f = 0) keep 1.
+    """
+    theta = np.asarray(theta_cmd, dtype=np.float64)
+    if corner_hz is None:
+        return np.ones(len(theta))
+    if not corner_hz > 0:
+        raise InputError(f"the error corner frequency must be > 0 Hz, got {corner_hz}")
+    return 1.0 / (1.0 + (command_frequency(theta, f_s) / corner_hz) ** 2)  # type: ignore[no-any-return]
+
+
 class Fitness:
     """eq. (3) against one reference: call it on LF currents (shape (n,) or (m, n)) for err [A²].
 
-    `mask` (0/1 per sample, e.g. `moving_mask`) leaves samples out of the sum.
+    `mask` (0/1 per sample, e.g. `moving_mask`) leaves samples out of the sum; `emphasis` (≥ 0
+    per sample, e.g. `error_weights`) scales each sample's weight.
     """
 
-    def __init__(self, reference: Comparison, slope_unit: str = "s", mask: ArrayLike | None = None) -> None:
+    def __init__(
+        self,
+        reference: Comparison,
+        slope_unit: str = "s",
+        mask: ArrayLike | None = None,
+        emphasis: ArrayLike | None = None,
+    ) -> None:
         if slope_unit not in SLOPE_UNITS:
             raise InputError(f"unknown slope unit {slope_unit!r}; use one of {', '.join(SLOPE_UNITS)}")
         self.reference = reference
@@ -210,6 +246,13 @@ class Fitness:
             if m.shape != self.weights.shape:
                 raise ValueError(f"mask has shape {m.shape}, the reference {self.weights.shape}")
             self.weights = self.weights * m
+        if emphasis is not None:
+            e = np.asarray(emphasis, dtype=np.float64)
+            if e.shape != self.weights.shape:
+                raise ValueError(f"emphasis has shape {e.shape}, the reference {self.weights.shape}")
+            if not np.all(np.isfinite(e) & (e >= 0)):
+                raise ValueError("emphasis must be finite and >= 0")
+            self.weights = self.weights * e
         # the comparison filter (`signals.lowpass`) for the fused kernel: sosfiltfilt's defaults
         self.sos: NDArray[np.float64] = butter(FILTER_ORDER, CUTOFF_HZ, fs=reference.f_s, output="sos")
         self.zi: NDArray[np.float64] = sosfilt_zi(self.sos)

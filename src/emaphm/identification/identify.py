@@ -34,7 +34,7 @@ from ..params import EmaParams
 from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect, load_thresholds
-from .fitness import BAND_HZ, Fitness, band_mask, moving_mask
+from .fitness import BAND_HZ, ERROR_CORNER_HZ, Fitness, band_mask, error_weights, moving_mask
 from .metrics import absolute_errors, percent_error, wrap_phase
 from .optimizers import (
     OnGeneration,
@@ -188,6 +188,11 @@ class FaultIdentifier:
         Refine the best point with a small CMA-ES (≤ 1600 more evaluations).
     slope_unit : {"s", "ms"}
         Time unit of the slope in the eq. (3) weights.
+    error_corner_hz : float, None or "auto"
+        Corner f_c [Hz] of `fitness.error_weights`, which weight eq. (3) by 1/(1 + (f/f_c)²) of
+        the command's local frequency f: where the monitor is known to err more, a sample pulls
+        less. "auto": `fitness.ERROR_CORNER_HZ` with the default monitor, None (the paper's eq. 3)
+        with the paper's.
     monitor : MonitorEma, optional
         The calibrated monitor model (its command is replaced by the reference's if given).
     on_generation : callable(gen, max_gen, best), optional
@@ -205,6 +210,7 @@ class FaultIdentifier:
         rtol: float = 1e-3,
         local_polish: bool = True,
         slope_unit: str = "s",
+        error_corner_hz: float | str | None = "auto",
         monitor: MonitorEma | None = None,
         on_generation: OnGeneration | None = None,
     ) -> None:
@@ -216,6 +222,7 @@ class FaultIdentifier:
         self.rtol = rtol
         self.local_polish = local_polish
         self.slope_unit = slope_unit
+        self.error_corner_hz = error_corner_hz
         self.monitor = monitor
         self.on_generation = on_generation
 
@@ -233,7 +240,8 @@ class FaultIdentifier:
         filtered measurement on the model grid over that span), `mask_` (the samples compared:
         `fitness.moving_mask` times `fitness.band_mask`), `compared_` (their fraction of the whole
         recording), `above_band_` (the fraction left out as faster than `fitness.BAND_HZ`) and
-        `objective_` (eq. 3 over them):
+        `error_corner_hz_` (the resolved corner of the frequency weights, None: none) and
+        `objective_` (eq. 3 over them, so weighted):
         ``objective_.of_monitor(monitor_, K, duration=duration_)`` scores fault rows K exactly as
         the search does.
         """
@@ -277,6 +285,8 @@ class FaultIdentifier:
                 f"only {len(kept)} samples of the recording can be compared (at least {MIN_SAMPLES} are needed): "
                 f"the others are rests in a hold, or a command faster than the {BAND_HZ:g} Hz the monitor was fitted on"
             )
+        corner = resolve_error_corner(self.error_corner_hz, monitor.monitor)
+        emphasis = error_weights(theta_grid, f_s, corner)
         self.compared_ = float(mask.mean())  # of the whole recording
         self.above_band_ = float(1.0 - in_band.mean())
         # what follows the last compared sample is not simulated: the search then costs what the
@@ -290,11 +300,11 @@ class FaultIdentifier:
             self.whole_ = Comparison.from_trace(t - t[0], i_q, grid, f_s)
             duration = float(grid[end - 1] - grid[0])
             grid, theta_grid = monitor.sample_grid(duration)
-            mask = mask[: len(grid)]
+            mask, emphasis = mask[: len(grid)], emphasis[: len(grid)]
         reference = Comparison.from_trace(t - t[0], i_q, grid, f_s)
         self.monitor_, self.duration_, self.reference_ = monitor, duration, reference
-        self.mask_ = mask
-        self.objective_ = Fitness(reference, self.slope_unit, self.mask_)
+        self.mask_, self.error_corner_hz_ = mask, corner
+        self.objective_ = Fitness(reference, self.slope_unit, self.mask_, emphasis)
         return self
 
     def fit(
@@ -467,6 +477,19 @@ def recentre_phase(run: OptimizerRun) -> OptimizerRun:
     return OptimizerRun(x, run.f, run.evaluations, run.history)
 
 
+def resolve_error_corner(value: float | str | None, monitor: str) -> float | None:
+    """The corner [Hz] of the frequency weights (`fitness.error_weights`) an identification uses:
+    "auto" gives `fitness.ERROR_CORNER_HZ` with the default monitor and None (none, the paper's
+    eq. 3) with the paper's; a number > 0 is used as given."""
+    if value == "auto":
+        return ERROR_CORNER_HZ if monitor == "default" else None
+    if value is None:
+        return None
+    if isinstance(value, str) or not np.isfinite(value) or not value > 0:
+        raise InputError(f"the error corner must be 'auto', None or a frequency > 0 Hz, got {value!r}")
+    return float(value)
+
+
 def search_to_faults(X: NDArray[np.float64]) -> NDArray[np.float64]:
     """Map the optimiser's box [0, 1]^8 to fault vectors: k7 = (2·x7 − 0.5) mod 1, the rest as is.
 
@@ -490,6 +513,7 @@ def identify(
     generations: int | None = None,
     local_polish: bool = True,
     slope_unit: str = "s",
+    error_corner_hz: float | str | None = "auto",
     on_generation: OnGeneration | None = None,
     thresholds: dict[str, float] | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
@@ -508,6 +532,9 @@ def identify(
     packaged one by default); one made for other actuator parameters raises `InputError`.
     `monitor` picks the monitor model: "default", or "paper" (the paper's single-phase model,
     eqs. 1–2 alone, to reproduce the paper); None: the calibration's (`MonitorEma`).
+
+    `error_corner_hz` weights eq. (3) by the command's local frequency (`FaultIdentifier`): "auto"
+    (default) as the monitor was measured to need, None for the paper's eq. 3 unweighted.
 
     `uncertainty` gives each fault a 90 % interval and flags (`uncertainty`, docs/uncertainty.md):
     "laplace" (default, ≈ 33 more evaluations), "mcmc" (emcee, the ``emaphm[uq]`` extra; minutes)
@@ -543,6 +570,7 @@ def identify(
     monitor_model = MonitorEma(
         actuator, calibration=calibration, monitor=monitor
     )  # one that does not fit: now
+    resolve_error_corner(error_corner_hz, monitor_model.monitor)  # a bad value: before the twin runs
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -587,7 +615,7 @@ def identify(
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
-        slope_unit=slope_unit, monitor=monitor_model, on_generation=on_generation,
+        slope_unit=slope_unit, error_corner_hz=error_corner_hz, monitor=monitor_model, on_generation=on_generation,
     )  # fmt: skip
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
@@ -687,6 +715,8 @@ def identify(
         # the span the search simulates: it ends TAIL_MARGIN_S after the last compared sample
         "compared_span_s": round(ident.duration_, 4),
         "slope_unit": slope_unit,
+        # the corner of eq. 3's frequency weights 1/(1 + (f/f_c)^2) [Hz]; None: unweighted (fitness.error_weights)
+        "error_corner_hz": ident.error_corner_hz_,
         "workers": workers,
         "optimizer_wall_time_s": round(ident.wall_time_, 3),
         "calibration": {
