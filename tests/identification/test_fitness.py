@@ -191,6 +191,22 @@ def test_error_weights_follow_the_command_frequency_and_the_emphasis_scales_eq3(
     np.testing.assert_array_equal(error_weights(np.sin(40 * t), f_s, None), 1.0)
     with pytest.raises(InputError, match="corner"):
         error_weights(np.sin(40 * t), f_s, 0.0)
+    # fast motion's weight outlasts it by ERROR_MEMORY_S: the chirp's ramp back and the stop that
+    # follows it weigh as the chirp's 10 Hz end, the hold after them as slow; the rising sweep alone
+    # is unchanged by that memory
+    from emaphm.commands import ChirpHold
+    from emaphm.identification.fitness import ERROR_CORNER_HZ, ERROR_MEMORY_S, command_frequency
+
+    hold = ChirpHold()
+    th = np.arange(int(hold.duration * f_s) + 1) / f_s
+    w = error_weights(hold(th), f_s)
+    end = w[int(0.99 * f_s)]
+    after = (th > hold.T) & (th < hold.T + ERROR_MEMORY_S - 1e-3)
+    assert end < 0.1 and np.all(w[after] == end) and np.all(w[th > hold.T + ERROR_MEMORY_S + 1e-3] > 0.9)
+    chirp = Chirp()(th[th <= 1.0])
+    np.testing.assert_array_equal(
+        error_weights(chirp, f_s), 1 / (1 + (command_frequency(chirp, f_s) / ERROR_CORNER_HZ) ** 2)
+    )
     # the emphasis multiplies eq. 3's weights: a difference where it is 0 costs nothing
     current = 0.3 * np.sin(2 * np.pi * 4 * T)
     ref = Comparison.from_signal(T, current, F_S)

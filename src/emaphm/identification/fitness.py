@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.ndimage import maximum_filter1d
 from scipy.signal import butter, sosfilt_zi
 
 from ..errors import InputError
@@ -35,6 +36,7 @@ if TYPE_CHECKING:
 __all__ = [
     "BAND_HZ",
     "ERROR_CORNER_HZ",
+    "ERROR_MEMORY_S",
     "HOLD_SETTLE_S",
     "LONG_HOLD_S",
     "PARK_SETTLE_S",
@@ -142,6 +144,13 @@ BAND_HZ = 10.0
 # variance fitted there. Checked on cases of their own (BENCHMARKS.md, "Frequency weights").
 ERROR_CORNER_HZ = 2.4
 
+# the error of fast motion outlasts it while the transient decays: `error_weights` reads the
+# frequency as the highest over the last this long [s]. On the chirp followed by a 50 ms ramp back
+# and a hold, read as slow motion the ramp and the stop held 82 % of eq. 3 at the truth of a
+# random case (`benchmarks/monitor_error_at_truth.py --command chirp-hold --only 1 --window 0.1`
+# before this rule); the FDI chirp, whose frequency only rises, is unchanged by it
+ERROR_MEMORY_S = 0.1
+
 # a turn of the command counts as a reversal once it has come back this fraction of its peak
 # excursion (so that a recorded command's quantisation or noise makes no reversals)
 REVERSAL_FRACTION = 0.01
@@ -207,18 +216,24 @@ def error_weights(
     theta_cmd: ArrayLike, f_s: float, corner_hz: float | None = ERROR_CORNER_HZ
 ) -> NDArray[np.float64]:
     """Per-sample weights 1/(1 + (f/f_c)²) for the monitor's error growing with the command's local
-    frequency f (`command_frequency`; f_c = `corner_hz`, None: all 1).
+    frequency f (`command_frequency`, the highest over the last `ERROR_MEMORY_S`; f_c =
+    `corner_hz`, None: all 1).
 
     Multiplied into eq. (3) (`Fitness(emphasis=...)`), they make it the weighted least squares of
     a model error whose variance grows as 1 + (f/f_c)² (`ERROR_CORNER_HZ`): the motion where the
-    monitor is known to be less faithful pulls the estimate less. Holds and ramps (f = 0) keep 1.
+    monitor is known to be less faithful pulls the estimate less, and so does the stop that
+    follows it. Holds and ramps (f = 0) keep 1 once `ERROR_MEMORY_S` has passed.
     """
     theta = np.asarray(theta_cmd, dtype=np.float64)
     if corner_hz is None:
         return np.ones(len(theta))
     if not corner_hz > 0:
         raise InputError(f"the error corner frequency must be > 0 Hz, got {corner_hz}")
-    return 1.0 / (1.0 + (command_frequency(theta, f_s) / corner_hz) ** 2)  # type: ignore[no-any-return]
+    f = command_frequency(theta, f_s)
+    memory = round(ERROR_MEMORY_S * f_s)
+    if memory > 0 and len(f):  # the highest over [t - memory, t]: a trailing maximum
+        f = maximum_filter1d(f, size=memory + 1, origin=memory // 2, mode="nearest")
+    return 1.0 / (1.0 + (f / corner_hz) ** 2)  # type: ignore[no-any-return]
 
 
 class Fitness:
