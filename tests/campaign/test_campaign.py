@@ -140,6 +140,10 @@ def test_job_keys_are_content_keys(tmp_path):
          'faults = [0,0,0,0,0,0,0,0.5]', r"\[identify\] unknown key"),
         ('[campaign]\nname = "x"\n[identify]\noptimizer = "sa"\n[[actuator]]\nid = "a"\n'
          'faults = [0,0,0,0,0,0,0,0.5]', "optimizer"),
+        ('[campaign]\nname = "x"\n[identify]\nerror_corner = -2.0\n[[actuator]]\nid = "a"\n'
+         'faults = [0,0,0,0,0,0,0,0.5]', "error_corner"),
+        ('[campaign]\nname = "x"\n[identify]\nerror_corner = "fast"\n[[actuator]]\nid = "a"\n'
+         'faults = [0,0,0,0,0,0,0,0.5]', "error_corner"),
         ('[campaign]\nname = "x"\n', "no \\[\\[actuator\\]\\]"),
         ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 0\nseed = 1\nfaults = "random"', "count must be"),
         ('[campaign]\nname = "x"\n[[fleet]]\nprefix = "R"\ncount = 3\nfaults = "random"', "seed must be"),
@@ -291,3 +295,17 @@ def test_a_store_written_before_a_column_existed_still_reads(tmp_path):
         rows["k-old"]["uq_flags"] is None and rows["k-old"]["k1"] == 0.2 and rows["k-new"]["uq_flags"] == "[]"
     )
     assert rows["k-old"]["actuator"] == "007"
+
+
+def test_a_campaign_sets_the_error_corner_as_identify_does(tmp_path):
+    """[identify] error_corner reaches `emaphm.identify` as error_corner_hz ("off": None)."""
+    from emaphm.campaign.jobs import identify_kwargs
+
+    for given, passed in (('"off"', None), ('"auto"', "auto"), ("3", 3.0), ("1.5", 1.5)):
+        (tmp_path / "c.toml").write_text(
+            f'[campaign]\nname = "x"\n[identify]\nerror_corner = {given}\n'
+            '[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n'
+        )
+        (job,) = load_campaign(tmp_path / "c.toml").jobs()
+        kwargs = identify_kwargs(job.to_dict())
+        assert kwargs["error_corner_hz"] == passed and "error_corner" not in kwargs

@@ -26,6 +26,9 @@ def identify_kwargs(job: dict[str, Any], *, workers: int | None = 1) -> dict[str
     kwargs: dict[str, Any] = {"seed": job["identify_seed"], "workers": workers}
     if "polish" in settings:
         kwargs["local_polish"] = settings.pop("polish")
+    if "error_corner" in settings:  # "auto", "off" (the paper's eq. 3) or Hz
+        corner = settings.pop("error_corner")
+        kwargs["error_corner_hz"] = None if corner == "off" else corner
     kwargs.update(settings)
     if job["truth"] is not None:
         kwargs["true_faults"] = job["truth"]

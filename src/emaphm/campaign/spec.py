@@ -90,6 +90,7 @@ CAMPAIGN_KEYS = {"name", "seeds", "description"}
 IDENTIFY_KEYS = {
     "optimizer": str, "pop_size": int, "generations": int, "polish": bool, "uncertainty": str,
     "monitor": str, "calibration": Path, "uq_calibration": Path, "params": Path,
+    "error_corner": float,  # "auto", "off" or Hz, as identify --error-corner
 }  # fmt: skip
 ACTUATOR_KEYS = {"id", "faults", "reference", "references", "map", "flights", "start", "growth", "law", "params",
                  "calibration"}  # fmt: skip
@@ -392,7 +393,20 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key, value in data.items():
         kind = IDENTIFY_KEYS[key]
-        if kind is Path:
+        if key == "error_corner":
+            ok = value in ("auto", "off") or (
+                isinstance(value, int | float)
+                and not isinstance(value, bool)
+                and math.isfinite(value)
+                and value > 0
+            )
+            if not ok:
+                raise _fail(
+                    where,
+                    f"[identify] error_corner must be 'auto', 'off' or a frequency > 0 Hz, got {value!r}",
+                )
+            out[key] = value if isinstance(value, str) else float(value)
+        elif kind is Path:
             if not isinstance(value, str) or not (folder / value).is_file():
                 raise _fail(where, f"[identify] {key} = {value!r}: no such file")
             out[key] = str((folder / value).resolve())
