@@ -11,7 +11,6 @@ command imports what it needs.
 
 from __future__ import annotations
 
-import math
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
@@ -258,16 +257,14 @@ def identify(
 
 
 def _error_corner(text: str) -> float | str | None:
-    """--error-corner: 'auto', 'off' or a frequency > 0 [Hz]."""
-    if text in ("auto", "off"):
-        return None if text == "off" else "auto"
+    """--error-corner: 'auto', 'off' or a frequency > 0 [Hz] (`identify.parse_error_corner`)."""
+    from .identification.identify import parse_error_corner
+
     try:
-        value = float(text)
+        value: float | str = float(text)
     except ValueError:
-        value = float("nan")
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"--error-corner must be 'auto', 'off' or a frequency > 0 Hz, got {text!r}")
-    return value
+        value = text
+    return parse_error_corner(value, name="--error-corner")
 
 
 def _print_identification(data: dict[str, Any]) -> None:

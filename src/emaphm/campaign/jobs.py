@@ -26,9 +26,8 @@ def identify_kwargs(job: dict[str, Any], *, workers: int | None = 1) -> dict[str
     kwargs: dict[str, Any] = {"seed": job["identify_seed"], "workers": workers}
     if "polish" in settings:
         kwargs["local_polish"] = settings.pop("polish")
-    if "error_corner" in settings:  # "auto", "off" (the paper's eq. 3) or Hz
-        corner = settings.pop("error_corner")
-        kwargs["error_corner_hz"] = None if corner == "off" else corner
+    if "error_corner" in settings:  # "auto", None (the paper's eq. 3, "off" in the file) or Hz
+        kwargs["error_corner_hz"] = settings.pop("error_corner")
     kwargs.update(settings)
     if job["truth"] is not None:
         kwargs["true_faults"] = job["truth"]

@@ -393,19 +393,13 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key, value in data.items():
         kind = IDENTIFY_KEYS[key]
-        if key == "error_corner":
-            ok = value in ("auto", "off") or (
-                isinstance(value, int | float)
-                and not isinstance(value, bool)
-                and math.isfinite(value)
-                and value > 0
-            )
-            if not ok:
-                raise _fail(
-                    where,
-                    f"[identify] error_corner must be 'auto', 'off' or a frequency > 0 Hz, got {value!r}",
-                )
-            out[key] = value if isinstance(value, str) else float(value)
+        if key == "error_corner":  # as identify --error-corner; stored as identify takes it
+            from ..identification.identify import parse_error_corner
+
+            try:
+                out[key] = parse_error_corner(value, name="error_corner")
+            except InputError as exc:
+                raise _fail(where, f"[identify] {exc}") from None
         elif kind is Path:
             if not isinstance(value, str) or not (folder / value).is_file():
                 raise _fail(where, f"[identify] {key} = {value!r}: no such file")

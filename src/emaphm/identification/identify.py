@@ -8,6 +8,8 @@ eq. (3) on the comparison pipeline. `identify` is the library mirror of ``emaphm
 
 from __future__ import annotations
 
+import math
+import numbers
 import os
 import time
 from collections.abc import Callable
@@ -477,17 +479,28 @@ def recentre_phase(run: OptimizerRun) -> OptimizerRun:
     return OptimizerRun(x, run.f, run.evaluations, run.history)
 
 
-def resolve_error_corner(value: float | str | None, monitor: str) -> float | None:
-    """The corner [Hz] of the frequency weights (`fitness.error_weights`) an identification uses:
-    "auto" gives `fitness.ERROR_CORNER_HZ` with the default monitor and None (none, the paper's
-    eq. 3) with the paper's; a number > 0 is used as given."""
-    if value == "auto":
-        return ERROR_CORNER_HZ if monitor == "default" else None
+def parse_error_corner(value: Any, name: str = "the error corner") -> float | str | None:
+    """A setting of the frequency weights' corner, checked: "auto" stays "auto", "off" or None
+    gives None (the paper's eq. 3 unweighted), a number > 0 [Hz] its float; anything else
+    raises `InputError` naming the setting (`name`: the CLI option, the campaign key)."""
+    if isinstance(value, str) and value in ("auto", "off"):
+        return None if value == "off" else value
     if value is None:
         return None
-    if isinstance(value, str) or not np.isfinite(value) or not value > 0:
-        raise InputError(f"the error corner must be 'auto', None or a frequency > 0 Hz, got {value!r}")
-    return float(value)
+    hz = float(value) if isinstance(value, numbers.Real) and not isinstance(value, bool) else math.nan
+    if not (math.isfinite(hz) and hz > 0):
+        raise InputError(f"{name} must be 'auto', 'off' or a frequency > 0 Hz, got {value!r}")
+    return hz
+
+
+def resolve_error_corner(value: Any, monitor: str) -> float | None:
+    """The corner [Hz] of the frequency weights (`fitness.error_weights`) an identification uses:
+    "auto" gives `fitness.ERROR_CORNER_HZ` with the default monitor and None (none, the paper's
+    eq. 3) with the paper's; otherwise as `parse_error_corner` reads it."""
+    corner = parse_error_corner(value)
+    if corner == "auto":
+        return ERROR_CORNER_HZ if monitor == "default" else None
+    return corner  # type: ignore[return-value]
 
 
 def search_to_faults(X: NDArray[np.float64]) -> NDArray[np.float64]:
