@@ -168,6 +168,18 @@ def test_bad_calibration_files(tmp_path, content, match):
         load_calibration(tmp_path / "c.json")
 
 
+def test_a_format_3_calibration_reads_as_the_monitor_without_breakaway_ripple(tmp_path):
+    # version 3 files predate i_R: the same model with i_R = 0, so they keep giving their results
+    data = Calibration(Coefficients(k_FS=12.5, i_R=0.0), 1).to_json()
+    del data["coefficients"]["i_R"]
+    (tmp_path / "c.json").write_text(json.dumps({**data, "format_version": 3}))
+    assert load_calibration(tmp_path / "c.json").coefficients == Coefficients(k_FS=12.5, i_R=0.0)
+    # a version 4 file must name it
+    (tmp_path / "c.json").write_text(json.dumps(data))
+    with pytest.raises(InputError, match="coefficients must be"):
+        load_calibration(tmp_path / "c.json")
+
+
 def test_calibration_with_bad_coefficients(tmp_path):
     data = Calibration().to_json()
     data["coefficients"]["k_t_eq"] = 5.0

@@ -47,7 +47,10 @@ __all__ = [
 NOT_ACTUATOR = ("sigma_current", "sigma_position")  # noise levels: not part of what is calibrated
 
 FORMAT = "emaphm-lf-calibration"
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
+# version 3 lacks i_R (the monitor's breakaway ripple): its coefficients are the same model with
+# i_R = 0, read as such
+READABLE_VERSIONS = (3, FORMAT_VERSION)
 
 # GA search bounds of each calibrated coefficient (SI)
 COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -63,6 +66,9 @@ COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
     "delta_u": (-0.05, 0.1),  # [A]
     "delta_2": (-0.05, 0.05),  # [A]
     "V_H": (1e-4, 0.05),  # [V]
+    # [A]; the q current's ripple peak cannot exceed the hysteresis band's width h (0.1 A here):
+    # scaled with the actuator's h (`coefficient_bounds`)
+    "i_R": (0.0, 0.1),
 }
 
 
@@ -86,6 +92,7 @@ class Coefficients:
     delta_u : float  growth of that offset with the unbalance of the lost turns |U| (kernels.monitor.unbalance) [A]
     delta_2 : float  part of that offset in step with the shorted phases' 2θ_e pattern c₂ [A]
     V_H : float  q-axis voltage (R_eq·i + k_e,eq·ω_m) over which the offset reverses its sign [V]
+    i_R : float  peak of the loop's current ripple about i_m that breaks a stuck motor away [A]
     """
 
     k_FS: float = 1.0
@@ -100,15 +107,18 @@ class Coefficients:
     delta_u: float = 0.0
     delta_2: float = 0.0
     V_H: float = 0.01
+    i_R: float = 0.0
 
     def __post_init__(self) -> None:
-        # the nameplate-scaled coefficients are checked against their actuator's box by
-        # `check_bounds`; here only that they are positive
+        # the nameplate-scaled coefficients and i_R are checked against their actuator's box by
+        # `check_bounds`; here only that they are positive (i_R: not negative)
         for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
             v = getattr(self, name)
-            if name in NAMEPLATE_SCALED:
+            if name in ACTUATOR_SCALED:
                 lo, hi = 0.0, math.inf
-                ok = isinstance(v, (int, float)) and math.isfinite(v) and v > 0
+                ok = (
+                    isinstance(v, (int, float)) and math.isfinite(v) and (v > 0 or (name == "i_R" and v == 0))
+                )
             else:
                 ok = isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi
             if not ok:
@@ -129,7 +139,7 @@ class Coefficients:
             if not lo <= v <= hi:
                 raise InputError(
                     f"{where}: coefficient {name}={v!r} is outside its range [{lo:.4g}, {hi:.4g}]"
-                    + (" for these actuator parameters" if name in NAMEPLATE_SCALED else "")
+                    + (" for these actuator parameters" if name in ACTUATOR_SCALED else "")
                 )
 
     @property
@@ -153,14 +163,17 @@ class Coefficients:
 # the coefficients whose search box scales with the actuator's nameplate value (k_t = 1.5·p·ψ_m,
 # k_e = p·ψ_m, J = J_m + J_u/τ²): COEFFICIENT_BOUNDS holds their box for the nominal actuator
 NAMEPLATE_SCALED = ("k_t_eq", "k_e_eq", "J_eq")
+# all the coefficients whose box follows the actuator: those and i_R, which scales with the band h
+ACTUATOR_SCALED = (*NAMEPLATE_SCALED, "i_R")
 
 
 def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float, float]]:
     """The calibration's search box for an actuator (`COEFFICIENT_BOUNDS` for the nominal one).
 
     k_t,eq, k_e,eq and J_eq keep the nominal box's ratios to the nameplate k_t, k_e and J, so a
-    motor with twice the flux, say, is searched around its own constants; the dimensionless shape
-    coefficients and the loop surrogate keep their boxes.
+    motor with twice the flux, say, is searched around its own constants, and i_R its ratio to
+    the hysteresis band h; the dimensionless shape coefficients and the loop surrogate keep their
+    boxes.
     """
     ratio = _nameplate_ratios(params)
     return {
@@ -170,13 +183,14 @@ def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float
 
 
 def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
-    """k_t, k_e and J of `params` over the nominal actuator's (exactly 1 for the nominal one)."""
+    """k_t, k_e, J and the band h of `params` over the nominal actuator's (exactly 1 for the nominal one)."""
     nominal = EmaParams()
     params = params if params is not None else nominal
     return {
         "k_t_eq": params.motor.k_t / nominal.motor.k_t,
         "k_e_eq": params.motor.k_e / nominal.motor.k_e,
         "J_eq": params.transmission.J / nominal.transmission.J,
+        "i_R": params.inverter.h / nominal.inverter.h,
     }
 
 
@@ -298,7 +312,7 @@ def _command_of(record: Any) -> Any:
 def _parse(data: Any, where: str) -> Calibration:
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"{where}: not an emaphm LF calibration file")
-    if data.get("format_version") != FORMAT_VERSION:
+    if data.get("format_version") not in READABLE_VERSIONS:
         older = isinstance(data.get("format_version"), int) and data["format_version"] < FORMAT_VERSION
         raise InputError(
             f"{where}: calibration format version {data.get('format_version')!r}, expected {FORMAT_VERSION}"
@@ -312,6 +326,8 @@ def _parse(data: Any, where: str) -> Calibration:
     if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
         raise InputError(f"{where}: unknown monitor {monitor!r}; expected one of {', '.join(MONITOR_FILES)}")
     coeffs = data.get("coefficients")
+    if data["format_version"] == 3 and isinstance(coeffs, dict) and "i_R" not in coeffs:
+        coeffs = {**coeffs, "i_R": 0.0}
     if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
         raise InputError(f"{where}: coefficients must be exactly {', '.join(COEFFICIENT_BOUNDS)}")
     n_lf = data.get("n_lf")
@@ -357,9 +373,9 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
 MONITOR_FILES = {"default": "calibration.json", "paper": "calibration-paper.json"}
 
 
-# the loop-error surrogate's coefficients that the paper's monitor holds at zero (V_H, a scale,
-# has no effect then)
-SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2")
+# the loop-error surrogate's coefficients and the loop's breakaway ripple, which the paper's
+# monitor holds at zero (V_H, a scale, has no effect then)
+SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "i_R")
 
 
 def check_monitor(monitor: Any) -> str:

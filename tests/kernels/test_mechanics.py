@@ -75,3 +75,17 @@ def test_end_stop_clamps_user_and_motor():
     for _ in range(1000):
         theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, -0.5, dt, mp)
     assert omega_m < 0.0 and theta_m < 200.0 * (0.5 + 1e-4)
+
+
+def test_a_ripple_breaks_the_shaft_away_at_its_peak():
+    # a mean torque below breakaway with a ripple whose peak exceeds it: the LF monitor's case
+    T, ripple = 0.9 * F_S, 0.15 * F_S
+    assert np.all(run_friction(0.0, T, 100) == 0.0)  # without the ripple it holds
+    omega = friction_step(0.0, T, dt, J, 0.0, F_S, F_D, ripple)
+    assert omega == pytest.approx(dt * (T - F_D) / J, rel=1e-12)  # slides against F_D
+    assert friction_step(0.0, -T, dt, J, 0.0, F_S, F_D, ripple) < 0.0
+    # a peak short of breakaway holds, and so does one whose mean cannot beat F_D
+    assert friction_step(0.0, T, dt, J, 0.0, F_S, F_D, 0.05 * F_S) == 0.0
+    assert friction_step(0.0, 0.5 * F_D, dt, J, 0.0, F_S, F_D, F_S) == 0.0
+    # the ripple decides a breakaway only: a sliding shaft decelerates as without it
+    assert friction_step(1.0, T, dt, J, 0.0, F_S, F_D, ripple) == friction_step(1.0, T, dt, J, 0.0, F_S, F_D)

@@ -33,22 +33,34 @@ class MechanicsPack(NamedTuple):
 
 @jit
 def friction_step(
-    omega_m: float, T_act: float, dt: float, J: float, C: float, F_S: float, F_D: float
+    omega_m: float,
+    T_act: float,
+    dt: float,
+    J: float,
+    C: float,
+    F_S: float,
+    F_D: float,
+    T_ripple: float = 0.0,
 ) -> float:
     """Speed after one step of Borello's dry-friction model [rad/s].
 
     T_act is the active (driving) torque on the shaft. Four cases, decided every step:
-    1. stuck (ω = 0) and |T_act| ≤ F_S: stays stuck;
-    2. stuck and |T_act| > F_S: breaks away against F_D·sign(T_act);
+    1. stuck (ω = 0) and |T_act| + T_ripple ≤ F_S: stays stuck;
+    2. stuck and |T_act| + T_ripple > F_S: breaks away against F_D·sign(T_act);
     3. sliding: dynamic friction F_D·sign(ω) opposes the motion;
     4. the speed would cross zero within the step: it stops exactly (ω = 0), and case 1 or 2
        decides the next step. This is what makes stick–slip work with a fixed step.
+
+    T_ripple ≥ 0 is the peak of a torque ripple the step's T_act is the mean of: a model that
+    averages the ripple away (the LF monitor, over the hysteresis loop's switching) breaks away
+    when the ripple's peak would. 0 (the HF twin, which resolves its ripple) is the plain model.
+    A breakaway whose mean torque cannot beat F_D stays stuck for the step.
     """
     if omega_m == 0.0:
-        if abs(T_act) <= F_S:  # case 1
+        if abs(T_act) + T_ripple <= F_S:  # case 1
             return 0.0
-        s = 1.0 if T_act > 0.0 else -1.0  # case 2 (F_D <= F_S, so the sign is kept)
-        return dt * (T_act - F_D * s) / J
+        s = 1.0 if T_act > 0.0 else -1.0  # case 2
+        return dt * max(abs(T_act) - F_D, 0.0) * s / J
     s = 1.0 if omega_m > 0.0 else -1.0
     omega_new = omega_m + dt * (T_act - C * omega_m - F_D * s) / J  # case 3
     if omega_new * s <= 0.0:  # case 4
@@ -72,10 +84,19 @@ def backlash(theta_g: float, theta_u: float, B: float) -> float:
 
 
 @jit
-def mechanics_step(theta_m: float, omega_m: float, theta_u: float, T_m: float, dt: float, mp: MechanicsPack):  # type: ignore[no-untyped-def]
-    """One fixed step of the drive train: (θ_m, ω_m, θ_u) after motor torque T_m acted for dt."""
+def mechanics_step(
+    theta_m: float,
+    omega_m: float,
+    theta_u: float,
+    T_m: float,
+    dt: float,
+    mp: MechanicsPack,
+    T_ripple: float = 0.0,
+):  # type: ignore[no-untyped-def]
+    """One fixed step of the drive train: (θ_m, ω_m, θ_u) after motor torque T_m acted for dt
+    (T_ripple: the peak of a ripple about T_m that the step does not resolve, `friction_step`)."""
     T_act = T_m - mp.T_load / (mp.tau * mp.eta)  # DESIGN §3.8, load reflected through the gear
-    omega_m = friction_step(omega_m, T_act, dt, mp.J, mp.C, mp.F_S, mp.F_D)
+    omega_m = friction_step(omega_m, T_act, dt, mp.J, mp.C, mp.F_S, mp.F_D, T_ripple)
     theta_m += dt * omega_m
     theta_u = backlash(theta_m / mp.tau, theta_u, mp.B)
     # inelastic end-stops on the user side: the gear flank pressing the user into the stop is

@@ -41,6 +41,8 @@ LF_FIELDS = (
     "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
     # current-loop surrogate of the three-phase hysteresis loop's error (calibrated)
     "k_H", "delta_0", "delta_1", "delta_u", "delta_2", "V_H",
+    # the loop's current ripple at a breakaway (calibrated; `mechanics.friction_step`)
+    "i_R",
     # LF steps per sample period
     "n_lf",
 )  # fmt: skip
@@ -52,7 +54,7 @@ N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
  LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX,
- K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, N_LF) = range(N_FIELDS)  # fmt: skip
+ K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, N_LF) = range(N_FIELDS)  # fmt: skip
 
 
 @jit
@@ -201,7 +203,10 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
                 i, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
             )  # fmt: skip
             T_m = prm[K_T_EQ] * f_sc * f_ecc * i_m
-            theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp)
+            # the hysteresis loop's ripple about i_m, which this step averages away, breaks a stuck
+            # motor away at its peak: T_ripple = k_t,eq·φ_T·i_R (monitor-model.md §1)
+            T_r = abs(prm[K_T_EQ] * f_sc * f_ecc) * prm[I_R]
+            theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp, T_r)
             acc_i += i_m
             acc_T += T_m
 

@@ -72,7 +72,7 @@ def monitor_rows(
         "tau_i": [x.tau_i for x in coefficients], "k_H": [x.k_H for x in coefficients],
         "delta_0": [x.delta_0 for x in coefficients], "delta_1": [x.delta_1 for x in coefficients],
         "delta_u": [x.delta_u for x in coefficients], "delta_2": [x.delta_2 for x in coefficients],
-        "V_H": [x.V_H for x in coefficients],
+        "V_H": [x.V_H for x in coefficients], "i_R": [x.i_R for x in coefficients],
     }  # fmt: skip
     for name, per_row in cal.items():
         rows[:, IDX[name]] = per_row
