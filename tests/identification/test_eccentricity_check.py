@@ -98,3 +98,24 @@ def test_a_restart_far_worse_than_the_run_is_not_polished():
 
     out, move = try_eccentricity_directions(counted, run, polish_it=True)
     assert move is None and calls == [ECC_DIRECTIONS] and out.evaluations == 10 + ECC_DIRECTIONS
+
+
+def test_the_restart_is_polished_with_the_whole_budget():
+    # gains far below the early stop's tolerance (1e-3 relative) around the restart: the usual
+    # polish would stop after 15 generations without gain; the restart's runs on (up to its whole
+    # budget, or until CMA-ES's own tolerances end it)
+    from emaphm.identification.optimizers import POLISH_BUDGET, polish
+
+    bowl = polar(0.05, 0.6)
+
+    def shallow(X):
+        return 1.0 + 1e-6 * bowl(X)
+
+    trapped = point(0.0, 0.1)
+    run = OptimizerRun(trapped, 1.2, 0, [])
+    out, move = try_eccentricity_directions(shallow, run, seed=1, polish_it=True)
+    probe = point(ECC_PROBE, 0.625)
+    usual = polish(shallow, OptimizerRun(probe, float(shallow(probe)[0]), 0, []), seed=1)
+    assert move is not None and out.f < float(shallow(probe)[0])
+    assert usual.evaluations <= POLISH_BUDGET[0] * 17  # stopped by the 15-generation rule
+    assert out.evaluations - ECC_DIRECTIONS > 2 * usual.evaluations
