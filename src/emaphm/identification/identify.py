@@ -457,7 +457,7 @@ def try_eccentricity_directions(
     X = np.repeat(run.x[None, :], ECC_DIRECTIONS, axis=0)
     X[:, 5] = ECC_PROBE
     directions = np.arange(ECC_DIRECTIONS) / ECC_DIRECTIONS
-    X[:, 6] = (directions + 0.5) / 2.0  # the representative of k7 inside the box (`recentre_phase`)
+    X[:, 6] = phase_in_box(directions)
     f = np.asarray(evaluate(X), dtype=np.float64)
     f = np.where(np.isfinite(f), f, np.inf)
     best = int(np.argmin(f))
@@ -537,9 +537,13 @@ def recentre_phase(run: OptimizerRun) -> OptimizerRun:
     0.59 of its fitness). The fitness is unchanged: both representatives give the same k7.
     """
     x = np.array(run.x, dtype=np.float64, copy=True)
-    k7 = float(np.mod(2.0 * x[6] - 0.5, 1.0))
-    x[6] = (k7 + 0.5) / 2.0
+    x[6] = phase_in_box(float(np.mod(2.0 * x[6] - 0.5, 1.0)))
     return OptimizerRun(x, run.f, run.evaluations, run.history)
+
+
+def phase_in_box(k7: Any) -> Any:
+    """The representative x7 in [0.25, 0.75) of the direction k7 (`search_to_faults`' inverse)."""
+    return (k7 + 0.5) / 2.0
 
 
 def parse_error_corner(value: Any, name: str = "the error corner") -> float | str | None:

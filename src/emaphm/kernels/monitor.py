@@ -202,10 +202,11 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             i_m = loop_error(
                 i, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
             )  # fmt: skip
-            T_m = prm[K_T_EQ] * f_sc * f_ecc * i_m
+            k_t = prm[K_T_EQ] * f_sc * f_ecc  # k_t,eq·φ_T
+            T_m = k_t * i_m
             # the hysteresis loop's ripple about i_m, which this step averages away, breaks a stuck
             # motor away at its peak: T_ripple = k_t,eq·φ_T·i_R (monitor-model.md §1)
-            T_r = abs(prm[K_T_EQ] * f_sc * f_ecc) * prm[I_R]
+            T_r = abs(k_t) * prm[I_R]
             theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp, T_r)
             acc_i += i_m
             acc_T += T_m
