@@ -315,7 +315,8 @@ def _parse(data: Any, where: str) -> Calibration:
     if data.get("format_version") not in READABLE_VERSIONS:
         older = isinstance(data.get("format_version"), int) and data["format_version"] < FORMAT_VERSION
         raise InputError(
-            f"{where}: calibration format version {data.get('format_version')!r}, expected {FORMAT_VERSION}"
+            f"{where}: calibration format version {data.get('format_version')!r}, expected "
+            + " or ".join(map(str, READABLE_VERSIONS))
             + (
                 "; it was written by an older emaphm for another monitor model: run emaphm calibrate again"
                 if older
