@@ -119,3 +119,15 @@ def test_the_restart_is_polished_with_the_whole_budget():
     assert move is not None and out.f < float(shallow(probe)[0])
     assert usual.evaluations <= POLISH_BUDGET[0] * 17  # stopped by the 15-generation rule
     assert out.evaluations - ECC_DIRECTIONS > 2 * usual.evaluations
+
+
+def test_the_final_checks_take_the_best_finite_candidate_and_count_its_evaluations():
+    from emaphm.identification.identify import best_candidate
+
+    run = OptimizerRun(point(0.0, 0.3), 1.0, 100, [])
+    X = np.repeat(run.x[None, :], 4, axis=0)
+    X[:, 0] = [0.1, 0.2, 0.3, 0.4]
+    f, best, evaluations = best_candidate(lambda X: np.array([np.nan, 0.7, 0.2, -np.inf]), run, X)
+    assert best == 2  # NaN and -inf are failures, not the best candidate
+    assert np.isinf(f[0]) and np.isinf(f[3]) and f[2] == 0.2
+    assert evaluations == 104

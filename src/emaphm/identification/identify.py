@@ -376,6 +376,16 @@ class FaultIdentifier:
         return {"t": shown.t, "measured": shown.reference, "fitted": fitted, "compared": compared}
 
 
+def best_candidate(
+    evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]], run: OptimizerRun, X: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], int, int]:
+    """Evaluate the candidate points X (rows in search space) of a final check in one batch: their
+    fitness (not finite: inf), the index of the best and the run's evaluations with them counted."""
+    f = np.asarray(evaluate(X), dtype=np.float64)
+    f = np.where(np.isfinite(f), f, np.inf)
+    return f, int(np.argmin(f)), run.evaluations + len(X)
+
+
 # the five other assignments of the three short magnitudes (k3, k4, k5) to the phases A, B, C
 SHORT_PERMUTATIONS = ((0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 
@@ -405,10 +415,7 @@ def try_short_permutations(
         X[j, 2:5] = run.x[[2 + o for o in order]]
     for q in range(3):
         X[len(SHORT_PERMUTATIONS) + q, 2 + q] = 0.0
-    f = np.asarray(evaluate(X), dtype=np.float64)
-    f = np.where(np.isfinite(f), f, np.inf)
-    best = int(np.argmin(f))
-    evaluations = run.evaluations + len(X)
+    f, best, evaluations = best_candidate(evaluate, run, X)
     if not f[best] < run.f:
         return OptimizerRun(run.x, run.f, evaluations, run.history), None, None
     better = OptimizerRun(X[best], float(f[best]), evaluations, run.history)
@@ -458,10 +465,7 @@ def try_eccentricity_directions(
     X[:, 5] = ECC_PROBE
     directions = np.arange(ECC_DIRECTIONS) / ECC_DIRECTIONS
     X[:, 6] = phase_in_box(directions)
-    f = np.asarray(evaluate(X), dtype=np.float64)
-    f = np.where(np.isfinite(f), f, np.inf)
-    best = int(np.argmin(f))
-    evaluations = run.evaluations + len(X)
+    f, best, evaluations = best_candidate(evaluate, run, X)
     if not f[best] <= ECC_PROBE_WORTH * run.f:
         return OptimizerRun(run.x, run.f, evaluations, run.history), None
     probe = OptimizerRun(X[best], float(f[best]), evaluations, run.history)
