@@ -16,6 +16,7 @@ from emaphm.calibration import (
     load_calibration,
     params_hash,
 )
+from emaphm.commands import make_command
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import (
     CALIBRATION_COMMANDS,
@@ -168,13 +169,18 @@ def test_bad_calibration_files(tmp_path, content, match):
         load_calibration(tmp_path / "c.json")
 
 
-def test_a_format_3_calibration_reads_as_the_monitor_without_breakaway_ripple(tmp_path):
-    # version 3 files predate i_R: the same model with i_R = 0, so they keep giving their results
-    data = Calibration(Coefficients(k_FS=12.5, i_R=0.0), 1).to_json()
-    del data["coefficients"]["i_R"]
+def test_older_calibration_formats_read_as_the_monitor_without_what_they_lack(tmp_path):
+    # version 3 files predate i_R and i_D, version 4 files i_D: the same model with those at 0,
+    # so they keep giving their results
+    data = Calibration(Coefficients(k_FS=12.5), 1).to_json()
+    del data["coefficients"]["i_R"], data["coefficients"]["i_D"]
     (tmp_path / "c.json").write_text(json.dumps({**data, "format_version": 3}))
-    assert load_calibration(tmp_path / "c.json").coefficients == Coefficients(k_FS=12.5, i_R=0.0)
-    # a version 4 file must name it
+    assert load_calibration(tmp_path / "c.json").coefficients == Coefficients(k_FS=12.5, i_R=0.0, i_D=0.0)
+    data = Calibration(Coefficients(k_FS=12.5, i_R=0.05), 1).to_json()
+    del data["coefficients"]["i_D"]
+    (tmp_path / "c.json").write_text(json.dumps({**data, "format_version": 4}))
+    assert load_calibration(tmp_path / "c.json").coefficients == Coefficients(k_FS=12.5, i_R=0.05, i_D=0.0)
+    # the current version must name them
     (tmp_path / "c.json").write_text(json.dumps(data))
     with pytest.raises(InputError, match="coefficients must be"):
         load_calibration(tmp_path / "c.json")
@@ -245,3 +251,34 @@ def test_a_calibration_can_name_its_own_commands():
         calibrate(pop_size=4, generations=1, fit=fit, check=[])
     with pytest.raises(InputError, match="at least one fitting scenario"):
         calibrate(pop_size=4, generations=1, fit=[], check=[], commands=rig)
+
+
+@pytest.mark.parametrize(("amplitude", "dead"), [(0.0004, True), (0.0015, False)])
+def test_the_loop_rests_at_standstill_while_the_demand_stays_inside_its_band(amplitude, dead):
+    # the twin's comparators: a stuck motor (no back-EMF) whose demand lies inside every phase's
+    # band h carries no current at all (a zero vector); a demand outside it is followed. The
+    # monitor's dead zone (i_D = h/2, the twin's half-band) does the same; without it the monitor
+    # carries the demand
+    cmd = make_command("step", amplitude=amplitude, t_0=0.002, duration=0.03)
+    k = np.array([0.5, 0, 0, 0, 0, 0, 0.5, 0.5])  # friction high enough to hold the motor
+    hf = emaphm.HighFidelityEma(None, cmd).simulate(k, noise=False)
+    late = hf.t > 0.01
+    assert np.all(hf.omega_m == 0.0)
+    demand = np.mean(np.abs(hf.i_q_ref[late]))
+    assert 0.015 < demand < 0.12
+    cal = default_calibration()
+    with_zone, without = (
+        MonitorEma(
+            None, cmd, dataclasses.replace(cal, coefficients=dataclasses.replace(cal.coefficients, i_D=i_D))
+        )
+        .simulate(k)
+        .i_q[late]
+        for i_D in (0.5 * emaphm.EmaParams().inverter.h, 0.0)
+    )
+    assert np.mean(np.abs(without)) > 0.7 * demand
+    if dead:
+        assert np.max(np.abs(hf.i_q[late])) < 0.002
+        assert np.max(np.abs(with_zone)) < 0.002
+    else:
+        assert np.mean(np.abs(hf.i_q[late])) > 0.7 * demand
+        assert np.mean(np.abs(with_zone)) > 0.7 * demand

@@ -47,10 +47,10 @@ __all__ = [
 NOT_ACTUATOR = ("sigma_current", "sigma_position")  # noise levels: not part of what is calibrated
 
 FORMAT = "emaphm-lf-calibration"
-FORMAT_VERSION = 4
-# version 3 lacks i_R (the monitor's breakaway ripple): its coefficients are the same model with
-# i_R = 0, read as such
-READABLE_VERSIONS = (3, FORMAT_VERSION)
+FORMAT_VERSION = 5
+# version 3 lacks i_R (the monitor's breakaway ripple) and i_D (its dead zone at standstill),
+# version 4 lacks i_D: their coefficients are the same model with those at 0, read as such
+READABLE_VERSIONS = (3, 4, FORMAT_VERSION)
 
 # GA search bounds of each calibrated coefficient (SI)
 COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -69,6 +69,9 @@ COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
     # [A]; the q current's ripple peak cannot exceed the hysteresis band's width h (0.1 A here):
     # scaled with the actuator's h (`coefficient_bounds`)
     "i_R": (0.0, 0.1),
+    # [A]; the half-band of the loop's dead zone at standstill: h/2 in the twin's comparators, up
+    # to h for what the monitor's averaged loop needs; scaled with the actuator's h too
+    "i_D": (0.0, 0.1),
 }
 
 
@@ -93,6 +96,7 @@ class Coefficients:
     delta_2 : float  part of that offset in step with the shorted phases' 2θ_e pattern c₂ [A]
     V_H : float  q-axis voltage (R_eq·i + k_e,eq·ω_m) over which the offset reverses its sign [V]
     i_R : float  peak of the loop's current ripple about i_m that breaks a stuck motor away [A]
+    i_D : float  half-band of the loop's dead zone at standstill (kernels.monitor.standstill_dead_zone) [A]
     """
 
     k_FS: float = 1.0
@@ -108,16 +112,19 @@ class Coefficients:
     delta_2: float = 0.0
     V_H: float = 0.01
     i_R: float = 0.0
+    i_D: float = 0.0
 
     def __post_init__(self) -> None:
-        # the nameplate-scaled coefficients and i_R are checked against their actuator's box by
-        # `check_bounds`; here only that they are positive (i_R: not negative)
+        # the nameplate-scaled coefficients, i_R and i_D are checked against their actuator's box by
+        # `check_bounds`; here only that they are positive (i_R, i_D: not negative)
         for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
             v = getattr(self, name)
             if name in ACTUATOR_SCALED:
                 lo, hi = 0.0, math.inf
                 ok = (
-                    isinstance(v, (int, float)) and math.isfinite(v) and (v > 0 or (name == "i_R" and v == 0))
+                    isinstance(v, (int, float))
+                    and math.isfinite(v)
+                    and (v > 0 or (name in BAND_SCALED and v == 0))
                 )
             else:
                 ok = isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi
@@ -163,8 +170,10 @@ class Coefficients:
 # the coefficients whose search box scales with the actuator's nameplate value (k_t = 1.5·p·ψ_m,
 # k_e = p·ψ_m, J = J_m + J_u/τ²): COEFFICIENT_BOUNDS holds their box for the nominal actuator
 NAMEPLATE_SCALED = ("k_t_eq", "k_e_eq", "J_eq")
-# all the coefficients whose box follows the actuator: those and i_R, which scales with the band h
-ACTUATOR_SCALED = (*NAMEPLATE_SCALED, "i_R")
+# the coefficients whose box scales with the actuator's hysteresis band h (and may be 0)
+BAND_SCALED = ("i_R", "i_D")
+# all the coefficients whose box follows the actuator
+ACTUATOR_SCALED = (*NAMEPLATE_SCALED, *BAND_SCALED)
 
 
 def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float, float]]:
@@ -190,7 +199,7 @@ def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
         "k_t_eq": params.motor.k_t / nominal.motor.k_t,
         "k_e_eq": params.motor.k_e / nominal.motor.k_e,
         "J_eq": params.transmission.J / nominal.transmission.J,
-        "i_R": params.inverter.h / nominal.inverter.h,
+        **{name: params.inverter.h / nominal.inverter.h for name in BAND_SCALED},
     }
 
 
@@ -327,8 +336,9 @@ def _parse(data: Any, where: str) -> Calibration:
     if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
         raise InputError(f"{where}: unknown monitor {monitor!r}; expected one of {', '.join(MONITOR_FILES)}")
     coeffs = data.get("coefficients")
-    if data["format_version"] == 3 and isinstance(coeffs, dict) and "i_R" not in coeffs:
-        coeffs = {**coeffs, "i_R": 0.0}
+    if isinstance(coeffs, dict):  # what an older version lacks is 0 (`READABLE_VERSIONS`)
+        absent = {3: ("i_R", "i_D"), 4: ("i_D",)}.get(data["format_version"], ())
+        coeffs = {**{name: 0.0 for name in absent if name not in coeffs}, **coeffs}
     if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
         raise InputError(f"{where}: coefficients must be exactly {', '.join(COEFFICIENT_BOUNDS)}")
     n_lf = data.get("n_lf")
@@ -374,9 +384,9 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
 MONITOR_FILES = {"default": "calibration.json", "paper": "calibration-paper.json"}
 
 
-# the loop-error surrogate's coefficients and the loop's breakaway ripple, which the paper's
-# monitor holds at zero (V_H, a scale, has no effect then)
-SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "i_R")
+# the loop-error surrogate's coefficients, the loop's breakaway ripple and its dead zone, which
+# the paper's monitor holds at zero (V_H, a scale, has no effect then)
+SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "i_R", "i_D")
 
 
 def check_monitor(monitor: Any) -> str:

@@ -41,8 +41,9 @@ LF_FIELDS = (
     "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
     # current-loop surrogate of the three-phase hysteresis loop's error (calibrated)
     "k_H", "delta_0", "delta_1", "delta_u", "delta_2", "V_H",
-    # the loop's current ripple at a breakaway (calibrated; `mechanics.friction_step`)
-    "i_R",
+    # the loop's current ripple at a breakaway (calibrated; `mechanics.friction_step`) and its
+    # dead zone at standstill (calibrated; `standstill_dead_zone`)
+    "i_R", "i_D",
     # LF steps per sample period
     "n_lf",
 )  # fmt: skip
@@ -54,7 +55,7 @@ N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
  LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX,
- K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, N_LF) = range(N_FIELDS)  # fmt: skip
+ K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, I_D, N_LF) = range(N_FIELDS)  # fmt: skip
 
 
 @jit
@@ -136,13 +137,30 @@ def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U
 
 
 @jit
+def standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, i_D):  # type: ignore[no-untyped-def]
+    """Whether the hysteresis loop rests on a zero vector: the motor stuck (ω_m = 0) and the demand
+    inside the band of every phase, |i_q,ref·u_x| < i_D for x = A, B, C (monitor-model.md §1).
+
+    The twin's comparators switch only when a phase current leaves its band i_x,ref ± h/2. With
+    no back-EMF to push the currents out and every band holding zero, the inverter settles on a
+    zero vector and the currents decay to zero through the windings, however the demand moves
+    inside the bands; i_D is that half-band seen by the monitor (h/2 in the twin; calibrated).
+    """
+    if omega_m != 0.0 or not i_D > 0.0:
+        return False
+    u_a, u_b, u_c = phase_directions(sin_e, cos_e)
+    return abs(i_q_ref) * max(abs(u_a), abs(u_b), abs(u_c)) < i_D
+
+
+@jit
 def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     """Run the LF model for one parameter row `prm` (layout `LF_FIELDS`).
 
     Writes i_out[k], the equivalent current averaged over the sample period ending at t_k (the
     HF i_q convention), and, when aux has rows, the `AUX_COLUMNS` at t_k.
 
-    The loop state i follows the demand (first-order lag); the motor carries, and the sensors
+    The loop state i follows the demand (first-order lag), or decays through the windings while
+    the loop rests in its dead zone at standstill (`standstill_dead_zone`); the motor carries, and the sensors
     measure, i_m = `loop_error`(i, …): the calibrated surrogate of the three-phase hysteresis
     loop's own error, which grows with the phase unbalance (monitor-model.md §1).
     """
@@ -155,6 +173,7 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     n_lf = int(prm[N_LF])
     dt = prm[T_S] / n_lf
     decay = math.exp(-dt / prm[TAU_I])
+    decay_rl = math.exp(-dt * prm[R_EQ] / prm[L_EQ])  # the windings' own decay, in the dead zone
     g = dt / prm[L_EQ]
     p = prm[P]
     # the loop's offset δ_H = δ_0 + δ_1·Σ_x (1 − N_x) + δ_U·|U|
@@ -194,9 +213,12 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             cos_e = math.cos(theta_e)
             f_sc = phi_sc(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS])
             f_ecc = phi_ecc(sin_e, cos_e, kz_cos, kz_sin)
-            i = current_loop_step(
-                i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
-            )
+            if standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, prm[I_D]):
+                i *= decay_rl  # a zero vector: the current decays through R_eq, L_eq
+            else:
+                i = current_loop_step(
+                    i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
+                )
             # the current the motor carries and the sensors measure: the loop's surrogate error on top
             c2 = unbalance_2(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C])
             i_m = loop_error(

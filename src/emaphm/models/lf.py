@@ -73,6 +73,7 @@ def monitor_rows(
         "delta_0": [x.delta_0 for x in coefficients], "delta_1": [x.delta_1 for x in coefficients],
         "delta_u": [x.delta_u for x in coefficients], "delta_2": [x.delta_2 for x in coefficients],
         "V_H": [x.V_H for x in coefficients], "i_R": [x.i_R for x in coefficients],
+        "i_D": [x.i_D for x in coefficients],
     }  # fmt: skip
     for name, per_row in cal.items():
         rows[:, IDX[name]] = per_row
