@@ -111,6 +111,15 @@ def test_the_calibration_box_scales_with_the_nameplate():
     with pytest.raises(InputError, match="k_t_eq"):
         guess.check_bounds(EmaParams())  # 0.3 N·m/A is out of the nominal actuator's box
     guess.check_bounds(strong)
+    # the loop's ripple and dead zone follow the hysteresis band h, and may be 0
+    wide = EmaParams(inverter=dataclasses.replace(EmaParams().inverter, h=0.2))
+    for name in ("i_R", "i_D"):
+        assert coefficient_bounds(wide)[name] == pytest.approx((0.0, 0.2))
+    with pytest.raises(InputError, match="i_D"):
+        Coefficients(i_D=0.15).check_bounds(EmaParams())
+    Coefficients(i_D=0.15).check_bounds(wide)
+    with pytest.raises(InputError, match="i_D"):
+        Coefficients(i_D=-0.01)
 
 
 def test_a_calibration_is_bound_to_the_actuator_it_was_made_for(tmp_path):
