@@ -48,9 +48,10 @@ NOT_ACTUATOR = ("sigma_current", "sigma_position")  # noise levels: not part of 
 
 FORMAT = "emaphm-lf-calibration"
 FORMAT_VERSION = 5
-# version 3 lacks i_R (the monitor's breakaway ripple) and i_D (its dead zone at standstill),
-# version 4 lacks i_D: their coefficients are the same model with those at 0, read as such
-READABLE_VERSIONS = (3, 4, FORMAT_VERSION)
+# the coefficients each older readable version lacks (i_R: the monitor's breakaway ripple, i_D: its
+# dead zone at standstill): its coefficients are the same model with those at 0, read as such
+OLDER_VERSIONS_LACK: dict[int, tuple[str, ...]] = {3: ("i_R", "i_D"), 4: ("i_D",)}
+READABLE_VERSIONS = (*OLDER_VERSIONS_LACK, FORMAT_VERSION)
 
 # GA search bounds of each calibrated coefficient (SI)
 COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -336,8 +337,8 @@ def _parse(data: Any, where: str) -> Calibration:
     if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
         raise InputError(f"{where}: unknown monitor {monitor!r}; expected one of {', '.join(MONITOR_FILES)}")
     coeffs = data.get("coefficients")
-    if isinstance(coeffs, dict):  # what an older version lacks is 0 (`READABLE_VERSIONS`)
-        absent = {3: ("i_R", "i_D"), 4: ("i_D",)}.get(data["format_version"], ())
+    if isinstance(coeffs, dict):  # what an older version lacks is 0
+        absent = OLDER_VERSIONS_LACK.get(data["format_version"], ())
         coeffs = {**{name: 0.0 for name in absent if name not in coeffs}, **coeffs}
     if not isinstance(coeffs, dict) or set(coeffs) != set(COEFFICIENT_BOUNDS):
         raise InputError(f"{where}: coefficients must be exactly {', '.join(COEFFICIENT_BOUNDS)}")
