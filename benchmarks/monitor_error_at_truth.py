@@ -9,7 +9,8 @@ For each of bench_multifault's random cases (its own seed 2611, noise off), per 
 command: the RMS of (filtered HF current − filtered monitor current at the true faults) against
 the RMS of the filtered HF current (mA, over the whole window), and the share of eq. 3 at the true faults that falls in
 the window, over the samples the identification compares (`FaultIdentifier.prepare`: holds at
-rest, parks and motion above the band left out). --floor adds the twin's own chaotic floor: the
+rest, parks and motion above the band left out); at the end of each line eq. 3 at the truth in
+all [1e-3 A²], with its sum, median and max over the cases. --floor adds the twin's own chaotic floor: the
 NRMSE of the HF current against the HF with friction k1 + 1e-5.
 
 --by-frequency measures where `fitness.ERROR_CORNER_HZ` comes from: on the calibration's fitting
@@ -60,6 +61,7 @@ def main() -> None:
     print(
         f"command {args.command}, windows of {args.window:g} s: error / HF RMS [mA] and share of eq. 3 at the truth"
     )
+    totals: list[float] = []
     for j, k in enumerate(cases):
         if only is not None and j not in only:
             continue
@@ -79,12 +81,16 @@ def main() -> None:
             ref = 1e3 * np.sqrt(np.mean(whole.reference[s] ** 2))
             share = cost[(tc >= a) & (tc < b)].sum() / cost.sum()
             cells.append(f"{err:5.1f}/{ref:5.1f} {share:4.2f}")
-        line = f"{j:>3} " + " | ".join(cells)
+        totals.append(float(cost.sum()))
+        line = f"{j:>3} " + " | ".join(cells) + f" | eq. 3 {1e3 * totals[-1]:7.2f}"
         if args.floor:
             k2 = k.copy()
             k2[0] += 1e-5
             line += f" | floor {100 * float(whole.nrmse(hf.simulate(k2, noise=False).i_q)):.2f} %"
         print(line, flush=True)
+    if totals:
+        print(f"eq. 3 at the truth [1e-3 A^2] over {len(totals)} cases: sum {1e3 * sum(totals):.1f}, "
+              f"median {1e3 * float(np.median(totals)):.2f}, max {1e3 * max(totals):.2f}")  # fmt: skip
 
 
 def by_frequency() -> None:

@@ -2,10 +2,12 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import emaphm
 from emaphm import read_trace
 from tests.helpers import run_cli
 
@@ -145,6 +147,9 @@ def test_calibrate_writes_a_loadable_file(tmp_path, capsys):
     assert cal.record["seed"] == 2 and cal.record["settings"]["generations"] == 1
 
 
+PACKAGED_CALIBRATION = Path(emaphm.__file__).parent / "data" / "calibration.json"
+
+
 @pytest.mark.parametrize(
     ("args", "reason"),
     [
@@ -152,6 +157,20 @@ def test_calibrate_writes_a_loadable_file(tmp_path, capsys):
         (["calibrate", "--output", "no/such/dir/cal.json"], "does not exist"),
         (["calibrate", "--workers", "-1"], "--workers"),
         (["calibrate", "--generations", "0"], "generations"),
+        (["calibrate", "--free", "bogus"], "cannot fit 'bogus' for the 'default' monitor"),
+        (["calibrate", "--free", "i_D", "--monitor", "paper"], "cannot fit 'i_D' for the 'paper' monitor"),
+        (["calibrate", "--free", ","], "at least one coefficient"),
+        (["calibrate", "--start", str(PACKAGED_CALIBRATION)], "--start needs --free"),
+        (
+            [
+                "calibrate",
+                "--free",
+                "i_D",
+                "--start",
+                str(PACKAGED_CALIBRATION.with_name("calibration-paper.json")),
+            ],
+            "is for the 'paper' monitor",
+        ),
     ],
 )
 def test_calibrate_bad_input(tmp_path, capsys, monkeypatch, args, reason):

@@ -282,3 +282,83 @@ def test_the_loop_rests_at_standstill_while_the_demand_stays_inside_its_band(amp
     else:
         assert np.mean(np.abs(hf.i_q[late])) > 0.7 * demand
         assert np.mean(np.abs(with_zone)) > 0.7 * demand
+
+
+def _locked_rotor_rests(I, theta_e, legs, h, span=0.005, dt=1e-7):
+    """The twin's comparators (`hf_twin._comparators`) on a locked rotor from rest (currents 0) with
+    every leg on `legs` (±1): whether the loop is still at rest after `span` s (currents within 1 mA)."""
+    import math
+
+    from emaphm.kernels.hf_twin import _comparators
+    from emaphm.kernels.transforms import phase_directions
+
+    p = emaphm.EmaParams()
+    R, L, V = p.motor.R_s, p.motor.L_s, p.inverter.V_dc
+    r = [I * u for u in phase_directions(math.sin(theta_e), math.cos(theta_e))]
+    i_a = i_b = i_c = 0.0
+    s = (legs, legs, legs)
+    for _ in range(int(span / dt)):
+        *s, _sw = _comparators(i_a, i_b, i_c, *s, *(x - h / 2 for x in r), *(x + h / 2 for x in r))
+        v_n = V / 2 * sum(s) / 3
+        i_a += dt * (V / 2 * s[0] - v_n - R * i_a) / L
+        i_b += dt * (V / 2 * s[1] - v_n - R * i_b) / L
+        i_c = -(i_a + i_b)
+    return max(abs(i_a), abs(i_b), abs(i_c)) < 1e-3
+
+
+@pytest.mark.parametrize("theta_e", [0.3, 1.4, 2.9, 4.0, 5.5])
+@pytest.mark.parametrize("demand", [-0.09, -0.055, 0.045, 0.07, 0.1])
+def test_the_monitors_dead_zone_follows_which_zero_vectors_the_twins_comparators_keep(theta_e, demand):
+    # sign conventions and sides of the band against the twin's own comparators: the monitor rests
+    # where a loop at rest on either zero vector stays there, carries half the demand where only
+    # one of them keeps it (even odds of sitting on it) and all of it where neither does
+    import math
+
+    from emaphm.kernels.monitor import MAY_REST_CARRY, standstill_dead_zone
+
+    h = emaphm.EmaParams().inverter.h
+    held = [_locked_rotor_rests(demand, theta_e, legs, h) for legs in (1.0, -1.0)]
+    carry = standstill_dead_zone(demand, 0.0, math.sin(theta_e), math.cos(theta_e), h / 2)
+    assert carry == {2: 0.0, 1: MAY_REST_CARRY, 0: 1.0}[sum(held)], (held, carry)
+
+
+def test_the_loop_carries_the_demand_by_how_many_zero_vectors_hold():
+    import math
+
+    from emaphm.kernels.monitor import MAY_REST_CARRY, standstill_dead_zone
+
+    i_D = 0.05
+    # θ_e = π/6: u = (−1/2, 1, −1/2); a positive demand I gives i_x,ref = (−I/2, I, −I/2): all legs
+    # up hold while I/2 < i_D, all legs down while I < i_D
+    s, c = math.sin(math.pi / 6), math.cos(math.pi / 6)
+    assert standstill_dead_zone(0.03, 0.0, s, c, i_D) == 0.0  # both hold: at rest
+    assert standstill_dead_zone(-0.03, 0.0, s, c, i_D) == 0.0
+    assert standstill_dead_zone(0.03, 0.2, s, c, i_D) == 1.0  # moving: the loop runs
+    assert standstill_dead_zone(0.08, 0.0, s, c, i_D) == MAY_REST_CARRY  # only all legs up hold
+    assert standstill_dead_zone(-0.08, 0.0, s, c, i_D) == MAY_REST_CARRY  # only all legs down hold
+    assert standstill_dead_zone(0.12, 0.0, s, c, i_D) == 1.0  # neither holds
+    assert standstill_dead_zone(0.01, 0.0, s, c, 0.0) == 1.0  # no dead zone (i_D = 0)
+    assert 0.0 < MAY_REST_CARRY < 1.0
+
+
+def test_a_calibration_can_fit_a_subset_and_hold_the_rest_at_a_given_calibration():
+    from emaphm.commands import Sine
+    from emaphm.identification.calibrate import Scenario
+
+    rig = {"rig": Sine(amplitude=0.002, frequency=3.0, duration=0.3)}
+    fit = [Scenario("a short on the rig", faults(k4=0.3), "rig")]
+    start = default_calibration()
+    cal = calibrate(
+        seed=2, pop_size=6, generations=2, fit=fit, check=[], commands=rig, free=["i_D"], start=start
+    )
+    new, old = dataclasses.asdict(cal.coefficients), dataclasses.asdict(start.coefficients)
+    assert {n for n in new if new[n] != old[n]} <= {"i_D"}
+    assert cal.record["settings"]["fitted"] == ["i_D"]
+    assert cal.record["settings"]["held_from"].startswith("given calibration made")
+    assert cal.record["before_calibration"]["coefficients"] == old
+    lo, hi = cal.record["settings"]["bounds"]["i_D"]
+    assert lo <= cal.coefficients.i_D <= hi
+    with pytest.raises(InputError, match="cannot fit 'i_D' for the 'paper' monitor"):
+        calibrate(monitor="paper", pop_size=4, generations=1, fit=fit, check=[], commands=rig, free=["i_D"])
+    with pytest.raises(InputError, match="at least one coefficient"):
+        calibrate(pop_size=4, generations=1, fit=fit, check=[], commands=rig, free=[])

@@ -310,20 +310,37 @@ def calibrate(
         str, typer.Option(help="Monitor model to calibrate: 'default', or 'paper' (eqs. 1-2 alone).")
     ] = "default",
     params: Annotated[Path | None, typer.Option("--params", help=PARAMS_HELP)] = None,
+    free: Annotated[
+        str | None,
+        typer.Option(
+            help="Fit only these coefficients (comma-separated, e.g. 'i_D'); the others are held at --start's."
+        ),
+    ] = None,
+    start: Annotated[
+        Path | None,
+        typer.Option(
+            help="Calibration whose coefficients --free leaves as they are (default: the packaged one)."
+        ),
+    ] = None,
 ) -> None:
     """Re-run the LF calibration against the HF twin (of the actuator file) and write the calibration file."""
     from .actuator import resolve_params
+    from .calibration import load_calibration
     from .identification.calibrate import calibrate as run_calibration
     from .io import check_output_path
     from .models import check_seed
 
     check_seed(seed)
-    check_output_path(output, suffixes=(".json",), inputs=(params,))
+    check_output_path(output, suffixes=(".json",), inputs=(params, start))
+    if start is not None and free is None:
+        raise InputError("--start needs --free: it names the coefficients the others are held for")
+    names = None if free is None else [n.strip() for n in free.split(",") if n.strip()]
     actuator = resolve_params(params)
+    held = None if start is None else load_calibration(start)
     with numba_threads(workers, name="--workers"), _progress() as update:
         cal = run_calibration(
             monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update,
-            params=actuator,
+            params=actuator, free=names, start=held,
         )  # fmt: skip
     cal.save(output)
     for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):

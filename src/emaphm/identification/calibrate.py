@@ -23,7 +23,15 @@ from pymoo.algorithms.soo.nonconvex.ga import GA
 
 from .._version import __version__
 from .._versions import versions
-from ..calibration import SURROGATE, Calibration, Coefficients, check_monitor, coefficient_bounds
+from ..calibration import (
+    SURROGATE,
+    Calibration,
+    Coefficients,
+    check_monitor,
+    coefficient_bounds,
+    default_calibration,
+    params_hash,
+)
 from ..commands import Chirp, ChirpHold, Command, Steps, command_record
 from ..errors import InputError
 from ..faults import HEALTHY, as_fault_vector, random_faults
@@ -201,6 +209,50 @@ def scenario_nrmse(
     return out
 
 
+def checked_free(free: Sequence[str] | None, allowed: Sequence[str], monitor: str) -> list[str]:
+    """The coefficients a calibration fits: `free` checked against the monitor's (all when None)."""
+    if free is None:
+        return list(allowed)
+    names = list(dict.fromkeys(free))
+    if not names:
+        raise InputError("free must name at least one coefficient to fit")
+    for n in names:
+        if n not in allowed:
+            raise InputError(
+                f"cannot fit {n!r} for the {monitor!r} monitor; choose from {', '.join(allowed)}"
+            )
+    return [n for n in allowed if n in names]  # in the box's order
+
+
+def held_coefficients(
+    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams
+) -> tuple[Coefficients, str]:
+    """The coefficients a calibration starts from and holds where it does not fit, and what they are.
+
+    The first guess without `free`; with it, `start` or the packaged calibration (of the nominal
+    actuator only: another actuator's must be given). `start` must be of the same monitor and
+    actuator.
+    """
+    if start is None and free is None:
+        return Coefficients.first_guess(params), "first guess"
+    if start is None:
+        if params_hash(params) != params_hash(EmaParams()):
+            raise InputError(
+                "fitting some coefficients of another actuator needs its own calibration to start from"
+            )
+        start = default_calibration(monitor)
+        label = "packaged"
+    else:
+        label = "given"
+    if start.monitor != monitor:
+        raise InputError(
+            f"the calibration to start from is for the {start.monitor!r} monitor, not {monitor!r}"
+        )
+    start.check_params(params, where="the calibration to start from")
+    made = start.record.get("created", "unknown date")
+    return start.coefficients, f"{label} calibration made {made} ({start.params_hash or 'unbound'})"
+
+
 def calibrate(
     *,
     monitor: str = "default",
@@ -213,6 +265,8 @@ def calibrate(
     check: Sequence[Scenario] | None = None,
     commands: Mapping[str, Command] | None = None,
     progress: Progress | None = None,
+    free: Sequence[str] | None = None,
+    start: Calibration | None = None,
 ) -> Calibration:
     """Fit the LF coefficients to the HF twin and check them on held-out scenarios.
 
@@ -227,6 +281,11 @@ def calibrate(
     `commands` names the commands the scenarios refer to (`CALIBRATION_COMMANDS` by default):
     e.g. ``commands={"rig": SampledCommand(t, theta)}`` with scenarios whose command is "rig"
     calibrates the monitor for a rig's own manoeuvre.
+
+    `free` names the coefficients to fit (default: all the monitor's); the others are held at
+    `start`'s (a calibration of the same monitor and actuator; default: the first guess, and with
+    `free` given, the packaged calibration of the nominal actuator). Re-fitting a subset measures
+    what one change of the monitor does without moving every coefficient with the GA's own spread.
     """
     seed = check_seed(seed)
     check_monitor(monitor)
@@ -245,20 +304,21 @@ def calibrate(
             raise InputError(
                 f"scenario {sc.name!r}: unknown command {sc.command!r}; choose one of {', '.join(commands)}"
             )
-    start = time.perf_counter()
+    # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
+    bounds = coefficient_bounds(params)
+    allowed = [n for n in bounds if not (paper and (n in SURROGATE or n == "V_H"))]
+    initial, held_from = held_coefficients(free, start, monitor, params)
+    fitted = checked_free(free, allowed, monitor)
+    began = time.perf_counter()
     fit_refs = hf_references(fit, params, noise=False, seed=seed, progress=progress, commands=commands)
     check_refs = hf_references(check, params, noise=False, seed=seed, progress=progress, commands=commands)
     check_refs_noisy = hf_references(
         check, params, noise=True, seed=seed, progress=progress, commands=commands
     )
-    # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
-    bounds = coefficient_bounds(params)
-    free = [n for n in bounds if not (paper and (n in SURROGATE or n == "V_H"))]
-    first_guess = Coefficients.first_guess(params)
-    fixed = dataclasses.asdict(first_guess)
+    fixed = dataclasses.asdict(initial)
 
     def coefficients(x: NDArray[np.float64]) -> Coefficients:
-        return Coefficients(**{**fixed, **{n: float(v) for n, v in zip(free, x, strict=True)}})
+        return Coefficients(**{**fixed, **{n: float(v) for n, v in zip(fitted, x, strict=True)}})
 
     def objective(X: NDArray[np.float64]) -> NDArray[np.float64]:
         return scenario_nrmse([coefficients(x) for x in X], fit, fit_refs, params, n_lf, commands).mean(
@@ -270,7 +330,7 @@ def calibrate(
             progress("GA generations", generation, total)
 
     # the mean NRMSE over the fitting scenarios as a function of the coefficient vector
-    lo, hi = zip(*(bounds[n] for n in free), strict=True)
+    lo, hi = zip(*(bounds[n] for n in fitted), strict=True)
     problem = BatchProblem(objective, lo, hi)
     # a fixed number of generations: no early stop
     x, _, history = minimize_batch(
@@ -280,7 +340,7 @@ def calibrate(
     fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands)[0]
     check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands)[0]
     check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf, commands)[0]
-    start_nrmse = scenario_nrmse([first_guess], fit + check, fit_refs + check_refs, params, n_lf, commands)[0]
+    start_nrmse = scenario_nrmse([initial], fit + check, fit_refs + check_refs, params, n_lf, commands)[0]
 
     def table(scenarios: Sequence[Scenario], values: NDArray[np.float64]) -> list[dict[str, Any]]:
         return [
@@ -308,19 +368,20 @@ def calibrate(
             "nrmse": "||I_HF - I_LF|| / ||I_HF - mean(I_HF)||, both filtered",
             "filter": f"Butterworth order {FILTER_ORDER}, {CUTOFF_HZ:g} Hz, zero phase (sosfiltfilt)",
             "bounds": {k: list(v) for k, v in bounds.items()},
-            "fitted": free,
+            "fitted": fitted,
+            "held_from": held_from,
             # the first is the main one (the FDI chirp); every command fitted or checked is listed
             "command": command_record(commands[next(iter(used))]),
             "commands": {c: command_record(commands[c]) for c in used},
             "params": params.to_dict(),
-            "wall_time_s": round(time.perf_counter() - start, 2),
+            "wall_time_s": round(time.perf_counter() - began, 2),
         },
         "ga_history": history,
         "fit_scenarios": table(fit, fit_nrmse),
         "check_scenarios": table(check, check_nrmse),
         "check_scenarios_noise_on": table(check, check_noisy),
         "before_calibration": {
-            "coefficients": dataclasses.asdict(first_guess),
+            "coefficients": dataclasses.asdict(initial),
             "scenarios": table(fit + check, start_nrmse),
         },
     }

@@ -136,20 +136,44 @@ def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U
     return i + di
 
 
+# Where exactly one zero vector holds (`standstill_dead_zone`), whether the twin's loop is at rest
+# depends on its legs' switching state, which the monitor does not carry: on a locked rotor under the
+# twin's own comparators it was at rest in 0.514 ± 0.018 of 800 trials coming from a running loop and
+# 0.500 ± 0.018 coming from rest (on either zero vector), against 1.000 where both hold and < 0.01
+# where none does (`python benchmarks/loop_rest_study.py`). There the monitor carries the expected
+# current, this fraction of the demand: least squares' best guess of a current that is either the
+# demand or nothing, at even odds.
+MAY_REST_CARRY = 0.5
+
+
 @jit
 def standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, i_D):  # type: ignore[no-untyped-def]
-    """Whether the hysteresis loop rests on a zero vector: the motor stuck (ω_m = 0) and the demand
-    inside the band of every phase, |i_q,ref·u_x| < i_D for x = A, B, C (monitor-model.md §1).
+    """The fraction of the demand i_q,ref the hysteresis loop carries: 0 where it rests on a zero
+    vector at standstill, 1 where it runs, `MAY_REST_CARRY` where it may do either
+    (monitor-model.md §1).
 
-    The twin's comparators switch only when a phase current leaves its band i_x,ref ± h/2. With
-    no back-EMF to push the currents out and every band holding zero, the inverter settles on a
-    zero vector and the currents decay to zero through the windings, however the demand moves
-    inside the bands; i_D is that half-band seen by the monitor (h/2 in the twin; calibrated).
+    The twin's comparators switch a leg only when its phase current leaves the band
+    i_x,ref ± h/2 on the far side: an upper leg down once i_x > i_x,ref + h/2, a lower one up once
+    i_x < i_x,ref − h/2. With the motor stuck (ω_m = 0: no back-EMF) an inverter on a zero vector
+    lets the currents decay to zero through the windings, so all legs up hold while
+    min_x i_x,ref > −h/2 and all legs down while max_x i_x,ref < h/2, whatever the demand does
+    inside that; i_D is that half-band seen by the monitor (h/2 in the twin; calibrated). Where
+    both hold (the demand inside every band) the loop is at rest; where neither does, it runs;
+    where only one does, it is at rest if it sits on that one, even odds whether it came from rest
+    or from running.
     """
     if omega_m != 0.0 or not i_D > 0.0:
-        return False
+        return 1.0
     u_a, u_b, u_c = phase_directions(sin_e, cos_e)
-    return abs(i_q_ref) * max(abs(u_a), abs(u_b), abs(u_c)) < i_D
+    top = i_q_ref * max(u_a, u_b, u_c)  # max_x i_x,ref (with a negative demand: min_x)
+    bottom = i_q_ref * min(u_a, u_b, u_c)
+    up = min(top, bottom) > -i_D  # all legs up hold
+    down = max(top, bottom) < i_D  # all legs down hold
+    if up and down:
+        return 0.0
+    if up or down:
+        return MAY_REST_CARRY
+    return 1.0
 
 
 @jit
@@ -213,11 +237,21 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             cos_e = math.cos(theta_e)
             f_sc = phi_sc(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS])
             f_ecc = phi_ecc(sin_e, cos_e, kz_cos, kz_sin)
-            if standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, prm[I_D]):
+            carry = standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, prm[I_D])
+            if carry == 0.0:
                 i *= decay_rl  # a zero vector: the current decays through R_eq, L_eq
             else:
                 i = current_loop_step(
-                    i, i_q_ref, omega_m, f_sc, f_sc * f_ecc, decay, g, prm[R_EQ], prm[K_E_EQ], prm[U_MAX]
+                    i,
+                    carry * i_q_ref,
+                    omega_m,
+                    f_sc,
+                    f_sc * f_ecc,
+                    decay,
+                    g,
+                    prm[R_EQ],
+                    prm[K_E_EQ],
+                    prm[U_MAX],
                 )
             # the current the motor carries and the sensors measure: the loop's surrogate error on top
             c2 = unbalance_2(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C])
