@@ -31,7 +31,8 @@ def calibration_tables() -> str:
         )
         noisy = {(s["name"], s["command"]): s["nrmse"] for s in rec.get("check_scenarios_noise_on", [])}
         first = {(s["name"], s["command"]): s["nrmse"] for s in rec["before_calibration"]["scenarios"]}
-        out.append("| scenario | command | role | NRMSE first guess | calibrated | calibrated, HF noise on |")
+        before = "first guess" if st.get("held_from", "first guess") == "first guess" else "start"
+        out.append(f"| scenario | command | role | NRMSE {before} | calibrated | calibrated, HF noise on |")
         out.append("|---|---|---|---|---|---|")
         for key, role in (("fit_scenarios", "fit"), ("check_scenarios", "held out")):
             for s in rec[key]:

@@ -362,3 +362,12 @@ def test_a_calibration_can_fit_a_subset_and_hold_the_rest_at_a_given_calibration
         calibrate(monitor="paper", pop_size=4, generations=1, fit=fit, check=[], commands=rig, free=["i_D"])
     with pytest.raises(InputError, match="at least one coefficient"):
         calibrate(pop_size=4, generations=1, fit=fit, check=[], commands=rig, free=[])
+    with pytest.raises(InputError, match="needs the coefficients to fit"):
+        calibrate(pop_size=4, generations=1, fit=fit, check=[], commands=rig, start=start)
+    with pytest.raises(InputError, match="made with n_lf = 1, this one uses 2"):
+        calibrate(
+            pop_size=4, generations=1, n_lf=2, fit=fit, check=[], commands=rig, free=["i_D"], start=start
+        )
+    other = emaphm.EmaParams(motor=dataclasses.replace(emaphm.EmaParams().motor, R_s=0.6))
+    with pytest.raises(InputError, match="its own calibration to start from"):
+        calibrate(pop_size=4, generations=1, params=other, fit=fit, check=[], commands=rig, free=["i_D"])

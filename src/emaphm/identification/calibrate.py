@@ -225,20 +225,23 @@ def checked_free(free: Sequence[str] | None, allowed: Sequence[str], monitor: st
 
 
 def held_coefficients(
-    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams
+    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams, n_lf: int = 1
 ) -> tuple[Coefficients, str]:
     """The coefficients a calibration starts from and holds where it does not fit, and what they are.
 
     The first guess without `free`; with it, `start` or the packaged calibration (of the nominal
-    actuator only: another actuator's must be given). `start` must be of the same monitor and
-    actuator.
+    actuator only: another actuator's must be given). `start` must be of the same monitor,
+    actuator and LF step (`n_lf`), and comes only with `free`.
     """
+    if start is not None and free is None:
+        raise InputError("a calibration to start from needs the coefficients to fit (free=, --free)")
     if start is None and free is None:
         return Coefficients.first_guess(params), "first guess"
     if start is None:
         if params_hash(params) != params_hash(EmaParams()):
             raise InputError(
-                "fitting some coefficients of another actuator needs its own calibration to start from"
+                "fitting some coefficients of another actuator needs its own calibration to start "
+                "from (start=, --start)"
             )
         start = default_calibration(monitor)
         label = "packaged"
@@ -249,6 +252,10 @@ def held_coefficients(
             f"the calibration to start from is for the {start.monitor!r} monitor, not {monitor!r}"
         )
     start.check_params(params, where="the calibration to start from")
+    if start.n_lf != n_lf:
+        raise InputError(
+            f"the calibration to start from was made with n_lf = {start.n_lf}, this one uses {n_lf}"
+        )
     made = start.record.get("created", "unknown date")
     return start.coefficients, f"{label} calibration made {made} ({start.params_hash or 'unbound'})"
 
@@ -283,8 +290,9 @@ def calibrate(
     calibrates the monitor for a rig's own manoeuvre.
 
     `free` names the coefficients to fit (default: all the monitor's); the others are held at
-    `start`'s (a calibration of the same monitor and actuator; default: the first guess, and with
-    `free` given, the packaged calibration of the nominal actuator). Re-fitting a subset measures
+    `start`'s (a calibration of the same monitor, actuator and `n_lf`; default: the packaged
+    calibration of the nominal actuator), which is also the record's `before_calibration`. Without
+    `free` every coefficient is fitted from the first guess and `start` must not be given. Re-fitting a subset measures
     what one change of the monitor does without moving every coefficient with the GA's own spread.
     """
     seed = check_seed(seed)
@@ -307,8 +315,8 @@ def calibrate(
     # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
     bounds = coefficient_bounds(params)
     allowed = [n for n in bounds if not (paper and (n in SURROGATE or n == "V_H"))]
-    initial, held_from = held_coefficients(free, start, monitor, params)
     fitted = checked_free(free, allowed, monitor)
+    initial, held_from = held_coefficients(free, start, monitor, params, n_lf)
     began = time.perf_counter()
     fit_refs = hf_references(fit, params, noise=False, seed=seed, progress=progress, commands=commands)
     check_refs = hf_references(check, params, noise=False, seed=seed, progress=progress, commands=commands)

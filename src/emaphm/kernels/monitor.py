@@ -141,8 +141,8 @@ def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U
 # twin's own comparators it was at rest in 0.514 ± 0.018 of 800 trials coming from a running loop and
 # 0.500 ± 0.018 coming from rest (on either zero vector), against 1.000 where both hold and < 0.01
 # where none does (`python benchmarks/loop_rest_study.py`). There the monitor carries the expected
-# current, this fraction of the demand: least squares' best guess of a current that is either the
-# demand or nothing, at even odds.
+# current, 1 − P(rest) ≈ 0.5 of the demand: least squares' best guess of a current that is either
+# the demand or nothing, at even odds.
 MAY_REST_CARRY = 0.5
 
 
@@ -183,8 +183,9 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     Writes i_out[k], the equivalent current averaged over the sample period ending at t_k (the
     HF i_q convention), and, when aux has rows, the `AUX_COLUMNS` at t_k.
 
-    The loop state i follows the demand (first-order lag), or decays through the windings while
-    the loop rests in its dead zone at standstill (`standstill_dead_zone`); the motor carries, and the sensors
+    The loop state i follows the demand (first-order lag), or, at standstill, the fraction of it
+    the loop carries (`standstill_dead_zone`: none inside every phase's band, where the state
+    decays through the windings; half in the ring where only one zero vector holds); the motor carries, and the sensors
     measure, i_m = `loop_error`(i, …): the calibrated surrogate of the three-phase hysteresis
     loop's own error, which grows with the phase unbalance (monitor-model.md §1).
     """
