@@ -358,6 +358,9 @@ def test_a_calibration_can_fit_a_subset_and_hold_the_rest_at_a_given_calibration
     assert cal.record["before_calibration"]["coefficients"] == old
     lo, hi = cal.record["settings"]["bounds"]["i_D"]
     assert lo <= cal.coefficients.i_D <= hi
+    # the start is in the first population: the fit ends no worse than where it began
+    before = [sc["nrmse"] for sc in cal.record["before_calibration"]["scenarios"]]
+    assert cal.record["fit_scenarios"][0]["nrmse"] <= before[0] + 1e-12
     with pytest.raises(InputError, match="cannot fit 'i_D' for the 'paper' monitor"):
         calibrate(monitor="paper", pop_size=4, generations=1, fit=fit, check=[], commands=rig, free=["i_D"])
     with pytest.raises(InputError, match="at least one coefficient"):

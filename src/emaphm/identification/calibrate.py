@@ -340,10 +340,15 @@ def calibrate(
     # the mean NRMSE over the fitting scenarios as a function of the coefficient vector
     lo, hi = zip(*(bounds[n] for n in fitted), strict=True)
     problem = BatchProblem(objective, lo, hi)
+    algorithm = GA(pop_size=pop_size)
+    if free is not None:
+        # a subset fit starts from where it is: the start's values are one of the first population
+        # (uniform in the box otherwise, from the seed), so the GA's elitism never ends it worse
+        X0 = np.random.default_rng(seed).uniform(lo, hi, size=(pop_size, len(fitted)))
+        X0[0] = np.clip([getattr(initial, n) for n in fitted], lo, hi)
+        algorithm = GA(pop_size=pop_size, sampling=X0)
     # a fixed number of generations: no early stop
-    x, _, history = minimize_batch(
-        problem, GA(pop_size=pop_size), generations, seed=seed, on_generation=on_generation
-    )
+    x, _, history = minimize_batch(problem, algorithm, generations, seed=seed, on_generation=on_generation)
     best = coefficients(x)
     fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands)[0]
     check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands)[0]
