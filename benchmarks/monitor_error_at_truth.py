@@ -10,8 +10,8 @@ command: the RMS of (filtered HF current − filtered monitor current at the tru
 the RMS of the filtered HF current (mA, over the whole window), and the share of eq. 3 at the true faults that falls in
 the window, over the samples the identification compares (`FaultIdentifier.prepare`: holds at
 rest, parks and motion above the band left out); at the end of each line eq. 3 at the truth in
-all [1e-3 A²], with its sum, median and max over the cases. --floor adds the twin's own chaotic floor: the
-NRMSE of the HF current against the HF with friction k1 + 1e-5.
+all [1e-3 A²], with its sum, median and max over the cases. --floor adds the twin's own chaotic
+floor: the NRMSE of the HF current against the HF with friction k1 + 1e-5.
 
 --by-frequency measures where `fitness.ERROR_CORNER_HZ` comes from: on the calibration's fitting
 scenarios under the FDI chirp (`calibrate.FIT_SCENARIOS`, none of the benchmark's cases), the RMS

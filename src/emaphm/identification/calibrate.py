@@ -291,9 +291,10 @@ def calibrate(
 
     `free` names the coefficients to fit (default: all the monitor's); the others are held at
     `start`'s (a calibration of the same monitor, actuator and `n_lf`; default: the packaged
-    calibration of the nominal actuator), which is also the record's `before_calibration`. Without
-    `free` every coefficient is fitted from the first guess and `start` must not be given. Re-fitting a subset measures
-    what one change of the monitor does without moving every coefficient with the GA's own spread.
+    calibration of the nominal actuator), which is also the record's `before_calibration`.
+    Without `free` every coefficient is fitted from the first guess and `start` must not be
+    given. Re-fitting a subset measures what one change of the monitor does without moving every
+    coefficient with the GA's own spread.
     """
     seed = check_seed(seed)
     check_monitor(monitor)

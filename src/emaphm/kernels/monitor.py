@@ -185,9 +185,10 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
 
     The loop state i follows the demand (first-order lag), or, at standstill, the fraction of it
     the loop carries (`standstill_dead_zone`: none inside every phase's band, where the state
-    decays through the windings; half in the ring where only one zero vector holds); the motor carries, and the sensors
-    measure, i_m = `loop_error`(i, …): the calibrated surrogate of the three-phase hysteresis
-    loop's own error, which grows with the phase unbalance (monitor-model.md §1).
+    decays through the windings; half in the ring where only one zero vector holds); the motor
+    carries, and the sensors measure, i_m = `loop_error`(i, …): the calibrated surrogate of the
+    three-phase hysteresis loop's own error, which grows with the phase unbalance
+    (monitor-model.md §1).
     """
     n = theta_cmd.shape[0]
     record = aux.shape[0] > 0
