@@ -341,6 +341,26 @@ def test_the_loop_carries_the_demand_by_how_many_zero_vectors_hold():
     assert 0.0 < MAY_REST_CARRY < 1.0
 
 
+def test_no_zero_vector_holds_beyond_the_ring_edge_at_any_angle():
+    import math
+
+    from emaphm.kernels.monitor import MAY_REST_CARRY, RING_OUTER, standstill_dead_zone
+
+    i_D = 0.05
+    edge = RING_OUTER * i_D
+    angles = np.linspace(0.0, 2 * math.pi, 721)
+    for sign in (1.0, -1.0):
+        beyond = [
+            standstill_dead_zone(sign * edge * 1.001, 0.0, math.sin(a), math.cos(a), i_D) for a in angles
+        ]
+        assert all(c == 1.0 for c in beyond)
+        # and the edge is tight: where one phase direction is ±1 the ring reaches it
+        within = [
+            standstill_dead_zone(sign * edge * 0.999, 0.0, math.sin(a), math.cos(a), i_D) for a in angles
+        ]
+        assert MAY_REST_CARRY in within
+
+
 def test_a_calibration_can_fit_a_subset_and_hold_the_rest_at_a_given_calibration():
     from emaphm.commands import Sine
     from emaphm.identification.calibrate import Scenario

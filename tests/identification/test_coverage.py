@@ -10,6 +10,7 @@ import pytest
 import emaphm
 from emaphm.calibration import default_calibration
 from emaphm.commands import Chirp, ChirpHold, Step
+from emaphm.errors import InputError
 from emaphm.identification.coverage import command_warnings
 from tests.helpers import run_cli
 
@@ -93,11 +94,13 @@ def test_a_chirp_with_a_hold_is_covered_and_its_held_samples_are_left_out():
     r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
     assert not any("calibrated on" in w for w in r.warnings)  # (a 8 x 1 search need not fit)
     # the command parks from 1.05 s: left out from PARK_SETTLE_S later, whatever the surface does
-    # (its slips there, the loop hunting against friction, kept 0.64-0.70 of the samples before)
-    from emaphm.identification.fitness import PARK_SETTLE_S
+    # (its slips there, the loop hunting against friction, kept 0.64-0.70 of the samples before),
+    # or from REST_SETTLE_S once the surface rests at a current below the monitor's ring edge
+    from emaphm.identification.fitness import PARK_SETTLE_S, REST_SETTLE_S
 
-    assert r.settings["samples_compared"] == pytest.approx((1.05 + PARK_SETTLE_S) / 2.0, abs=2e-3)
-    assert r.settings["compared_span_s"] == pytest.approx(1.05 + PARK_SETTLE_S + 0.05, abs=2e-3)
+    compared = r.settings["samples_compared"]
+    assert (1.05 + REST_SETTLE_S) / 2.0 - 2e-3 <= compared <= (1.05 + PARK_SETTLE_S) / 2.0 + 2e-3
+    assert r.settings["compared_span_s"] == pytest.approx(2.0 * compared + 0.05, abs=2e-3)
 
 
 def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are_flagged():
@@ -112,6 +115,10 @@ def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are
         },
         metadata={},
     )
+    # at a current below the monitor's ring edge the rest is left out after 5 ms: nothing to compare
+    with pytest.raises(InputError, match="only 51 samples of the recording can be compared"):
+        emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
+    rest.signals["i_q"] = rest.signals["i_q"] + 0.2  # the loop holding against a load: 20 ms compared
     r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
     assert r.settings["samples_compared"] < 0.15  # the first 20 ms of the 0.5 s park
     assert any("of the recording is compared" in w for w in r.warnings)

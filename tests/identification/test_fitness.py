@@ -91,6 +91,38 @@ def test_the_moving_mask_leaves_out_a_park_and_the_rests_of_a_staircase():
     assert 0.2 < resting.mean() < 0.3 and np.all(resting[(t > 0.2) & (t <= 0.25)] == 1.0)
 
 
+def test_the_moving_mask_leaves_out_rests_whose_current_is_below_the_ring_edge():
+    from emaphm.commands import Chirp, Steps
+    from emaphm.identification.fitness import HOLD_SETTLE_S, REST_SETTLE_S, moving_mask
+
+    f_s = 1e4
+    t = np.arange(10001) / f_s
+    steps = Steps(dwell=0.2)(t)
+    # the surface moves for 20 ms after each step, then rests; the current is 60 mA at rest in the
+    # first dwells and 300 mA (the loop running against the breakaway friction) in the later ones
+    since = np.mod(t, 0.2)
+    position = np.where(since < 0.02, 0.1 * since, 2e-3) + np.floor(t / 0.2)
+    small = np.where(t < 0.6, 0.06, 0.3)
+    edge = 0.1
+    base = moving_mask(steps, f_s, theta_u=position)
+    m = moving_mask(steps, f_s, theta_u=position, i_meas=small, rest_current=edge)
+    assert np.all(m <= base)  # only ever leaves more out
+    dwell = (t > 0.2) & (t < 0.4)  # the second dwell, small current
+    early = dwell & (since > 0.02 + REST_SETTLE_S + 2e-4) & (since < HOLD_SETTLE_S)
+    assert early.any() and np.all(m[early] == 0.0) and np.all(base[early] == 1.0)
+    moving = dwell & (since < 0.02)
+    assert np.all(m[moving] == 1.0)  # the surface still moves: kept
+    late = (t > 0.6) & (since > 0.02 + REST_SETTLE_S + 2e-4) & (since < HOLD_SETTLE_S)
+    assert late.any() and np.all(m[late] == 1.0)  # a rest carrying more than the edge: kept
+    # off without a current or an edge, and a command that never holds keeps every sample
+    assert np.array_equal(moving_mask(steps, f_s, theta_u=position, i_meas=small), base)
+    assert np.array_equal(moving_mask(steps, f_s, theta_u=position, rest_current=edge), base)
+    chirp = Chirp()(t)
+    assert np.all(moving_mask(chirp, f_s, theta_u=np.zeros_like(t), i_meas=0 * t, rest_current=edge) == 1.0)
+    with pytest.raises(ValueError, match="i_meas"):
+        moving_mask(steps, f_s, theta_u=position, i_meas=small[:-1], rest_current=edge)
+
+
 def test_a_masked_fitness_ignores_the_left_out_samples():
     current = 0.3 * np.sin(2 * np.pi * 4 * T)
     ref = Comparison.from_signal(T, current, F_S)

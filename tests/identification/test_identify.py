@@ -134,6 +134,32 @@ def test_phase_map_wraps_and_keeps_every_phase_away_from_the_bounds():
     assert inner.min() == 0.0 and inner.max() >= 0.99 - 1e-12  # grid step 0.01 in k7
 
 
+def test_rests_the_loop_may_or_may_not_carry_are_left_out_by_the_monitor_with_a_dead_zone():
+    """A staircase: the default monitor (i_D > 0) leaves out the rests whose measured current is
+    below its ring edge; the paper monitor (no dead zone) keeps the earlier rule."""
+    from emaphm.commands import SampledCommand, Steps
+    from emaphm.identification.fitness import band_mask, moving_mask
+    from emaphm.identification.identify import FaultIdentifier
+    from emaphm.kernels.monitor import RING_OUTER
+    from emaphm.models import HighFidelityEma, MonitorEma
+
+    k = np.array([0.2, 0.3, 0.3, 0.1, 0.0, 0.2, 0.4, 0.1])
+    trace = HighFidelityEma(command=Steps(dwell=0.2)).simulate(k, noise=False)
+    recorded = SampledCommand(trace.t, trace.theta_cmd)
+    default = FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, recorded, trace.theta_u)
+    paper = FaultIdentifier(monitor=MonitorEma(monitor="paper")).prepare(
+        trace.t, trace.i_q, recorded, trace.theta_u
+    )
+    grid, theta = paper.monitor_.sample_grid(paper.duration_)
+    f_s = paper.monitor_.params.controller.f_s
+    position = np.interp(grid, trace.t - trace.t[0], trace.theta_u)
+    assert np.array_equal(paper.mask_, moving_mask(theta, f_s, theta_u=position) * band_mask(theta, f_s))
+    assert len(default.mask_) == len(paper.mask_) and np.all(default.mask_ <= paper.mask_)
+    gone = (paper.mask_ > 0) & (default.mask_ == 0)
+    edge = RING_OUTER * default.monitor_.calibration.coefficients.i_D
+    assert gone.sum() > 100 and np.all(np.abs(default.reference_.reference[gone]) < edge)
+
+
 def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitted():
     """The chirp run on to 2 s: the second above 10 Hz is left out, and not simulated at all."""
     from emaphm.commands import Chirp, SampledCommand

@@ -41,6 +41,7 @@ __all__ = [
     "LONG_HOLD_S",
     "PARK_SETTLE_S",
     "REST_BAND",
+    "REST_SETTLE_S",
     "REVERSAL_FRACTION",
     "SLOPE_UNITS",
     "Fitness",
@@ -66,6 +67,10 @@ LONG_HOLD_S = 0.5
 # breakaway friction, and a 10 or 20 ms window there made one of 12 runs 13-18 %err
 PARK_SETTLE_S = 0.02
 
+# in a hold, a rest of the surface whose measured current is below the monitor's ring edge
+# (`moving_mask`) counts after this long [s]: the loop's switching state decides that current
+REST_SETTLE_S = 0.005
+
 # the surface counts as at rest while its measured position stays within this band [rad]: 10 LSB
 # of the 16-bit ±0.3 rad position sensor, 10 σ of its noise (DESIGN §7)
 REST_BAND = 1e-4
@@ -85,6 +90,8 @@ def moving_mask(
     settle: float = HOLD_SETTLE_S,
     theta_u: ArrayLike | None = None,
     park_settle: float = PARK_SETTLE_S,
+    i_meas: ArrayLike | None = None,
+    rest_current: float = 0.0,
 ) -> NDArray[np.float64]:
     """0 on the samples of a hold where the surface is stuck or parked, 1 everywhere else.
 
@@ -92,7 +99,10 @@ def moving_mask(
     after `park_settle` [s] is left out, whatever the surface does. In a shorter hold a sample is
     left out when the command has not moved for more than `settle` [s] and the measured surface
     position `theta_u` [rad] has stayed within `REST_BAND` over that time too; without `theta_u`
-    those dwells stay whole (the surface hunts through a staircase's 0.2 s dwells).
+    those dwells stay whole (the surface hunts through a staircase's 0.2 s dwells). With the
+    measured current `i_meas` [A] (filtered, on the same grid) a sample of a hold is also left out
+    once the surface has rested for `REST_SETTLE_S` and |i_meas| < `rest_current` [A] (the
+    identification passes the monitor's ring edge, `kernels.monitor.RING_OUTER` · i_D; 0: off).
 
     Where the surface rests, it sits wherever stick-slip left it, and the position loop's
     integrator ramps the current against that small error: the held current depends on the
@@ -105,7 +115,14 @@ def moving_mask(
     first 50 ms held 40-70 % of eq. (3) at the true faults on 5 cases), hence the short
     `park_settle`. After a step of a staircase the surface keeps moving (the loop hunts against
     friction and backlash) and those samples stay: they carry the faults. A command that never
-    holds keeps every sample.
+    holds keeps every sample. But where the stuck motor's demand is small the loop may rest on a
+    zero vector or run, depending on its legs' switching state (`kernels.monitor.standstill_dead_zone`):
+    the twin's current there is the demand or nothing, a coin flip the monitor can only average.
+    At the true faults such rests at the ends of a staircase's dwells held 62 % of eq. (3) on the
+    benchmark's worst steps case (the twin at rest carrying 0 mA at a demand of 65 mA, the monitor
+    half of it), and the search bought a better fit there by moving the shorts (issue 8). A rest
+    whose measured current lies below the ring's outer edge is therefore left out after a few
+    ms; a rest carrying more than that (the loop running against the breakaway friction) stays.
     """
     theta = np.asarray(theta_cmd, dtype=np.float64)
     n = len(theta)
@@ -123,6 +140,13 @@ def moving_mask(
         if pos.shape != theta.shape:
             raise ValueError(f"theta_u has shape {pos.shape}, theta_cmd {theta.shape}")
         held |= still & (idx - last_move > window) & (_trailing_spread(pos, window) <= REST_BAND)
+        if i_meas is not None and rest_current > 0.0:
+            cur = np.asarray(i_meas, dtype=np.float64)
+            if cur.shape != theta.shape:
+                raise ValueError(f"i_meas has shape {cur.shape}, theta_cmd {theta.shape}")
+            short = max(round(REST_SETTLE_S * f_s), 1)
+            rests = (idx - last_move > short) & (_trailing_spread(pos, short) <= REST_BAND)
+            held |= still & rests & (np.abs(cur) < rest_current)
     return np.where(held, 0.0, 1.0)
 
 

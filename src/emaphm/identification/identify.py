@@ -29,6 +29,7 @@ from ..commands import Chirp, Command, SampledCommand
 from ..errors import InputError, SimulationError
 from ..faults import FAULT_NAMES, as_fault_vector
 from ..io import read_trace
+from ..kernels.monitor import RING_OUTER
 from ..measured.checks import plausibility
 from ..measured.limits import MAX_SPAN, MIN_DURATION
 from ..models import HighFidelityEma, MonitorEma, check_seed
@@ -281,7 +282,14 @@ class FaultIdentifier:
                 raise InputError("theta_u must be finite and sampled at the reference's times")
             position = np.interp(grid, t - t[0], pos)
         in_band = band_mask(theta_grid, f_s)
-        mask = moving_mask(theta_grid, f_s, theta_u=position) * in_band
+        # the whole filtered measurement: for the rests whose current the loop's switching decides,
+        # and for the figures (`curves`) when the search sees less of it
+        whole = Comparison.from_trace(t - t[0], i_q, grid, f_s)
+        rest_current = RING_OUTER * monitor.calibration.coefficients.i_D
+        mask = (
+            moving_mask(theta_grid, f_s, theta_u=position, i_meas=whole.reference, rest_current=rest_current)
+            * in_band
+        )
         kept = np.flatnonzero(mask)
         if len(kept) < MIN_SAMPLES:
             raise InputError(
@@ -297,14 +305,13 @@ class FaultIdentifier:
         # TAIL_MARGIN_S of it is kept, so that the zero-phase filter's edge stays clear of the
         # compared samples (its transient decays as exp(-666 t): 3e-15 at 50 ms)
         end = int(min(len(grid), kept[-1] + 1 + round(TAIL_MARGIN_S * f_s)))
-        # the whole filtered measurement, for the figures (`curves`), when the search sees less of it
         self.whole_: Comparison | None = None
         if end < len(grid):
-            self.whole_ = Comparison.from_trace(t - t[0], i_q, grid, f_s)
+            self.whole_ = whole
             duration = float(grid[end - 1] - grid[0])
             grid, theta_grid = monitor.sample_grid(duration)
             mask, emphasis = mask[: len(grid)], emphasis[: len(grid)]
-        reference = Comparison.from_trace(t - t[0], i_q, grid, f_s)
+        reference = whole if self.whole_ is None else Comparison.from_trace(t - t[0], i_q, grid, f_s)
         self.monitor_, self.duration_, self.reference_ = monitor, duration, reference
         self.mask_, self.error_corner_hz_ = mask, corner
         self.objective_ = Fitness(reference, self.slope_unit, self.mask_, emphasis)
