@@ -3,6 +3,7 @@
     python benchmarks/monitor_error_at_truth.py [--command chirp-2s] [--cases 12] [--window 0.25]
                                                 [--case-seed 2611] [--only 0,12] [--floor]
     python benchmarks/monitor_error_at_truth.py --by-frequency
+    python benchmarks/monitor_error_at_truth.py --command steps --cases 20 --rest-share
 
 
 For each of bench_multifault's random cases (its own seed 2611, noise off), per window of the
@@ -12,6 +13,10 @@ the window, over the samples the identification compares (`FaultIdentifier.prepa
 rest, parks and motion above the band left out); at the end of each line eq. 3 at the truth in
 all [1e-3 A²], with its sum, median and max over the cases. --floor adds the twin's own chaotic
 floor: the NRMSE of the HF current against the HF with friction k1 + 1e-5.
+
+--rest-share prints per case, instead of the windows, eq. 3 at the true faults over the samples
+compared without the rests whose measured current is below the monitor's ring edge
+(`fitness.moving_mask` with `rest_current` 0) and the share of it that those rests hold.
 
 --by-frequency measures where `fitness.ERROR_CORNER_HZ` comes from: on the calibration's fitting
 scenarios under the FDI chirp (`calibrate.FIT_SCENARIOS`, none of the benchmark's cases), the RMS
@@ -31,7 +36,14 @@ from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS, FIT_SCENARIOS
-from emaphm.identification.fitness import ERROR_CORNER_HZ, command_frequency
+from emaphm.identification.fitness import (
+    ERROR_CORNER_HZ,
+    Fitness,
+    band_mask,
+    command_frequency,
+    error_weights,
+    moving_mask,
+)
 from emaphm.identification.identify import FaultIdentifier
 from emaphm.models import HighFidelityEma, MonitorEma
 
@@ -44,6 +56,11 @@ def main() -> None:
     parser.add_argument("--window", type=float, default=0.25, help="window length [s]")
     parser.add_argument("--only", default=None, help="comma-separated case numbers")
     parser.add_argument("--floor", action="store_true", help="also HF against HF with k1 + 1e-5")
+    parser.add_argument(
+        "--rest-share",
+        action="store_true",
+        help="the share of eq. 3 at the truth in the rests below the ring edge",
+    )
     parser.add_argument(
         "--by-frequency",
         action="store_true",
@@ -73,6 +90,12 @@ def main() -> None:
         )
         at_truth = ident.reference_.filtered(ident.monitor_.simulate(k, duration=ident.duration_).i_q)
         cost = ident.objective_.weights * (ident.reference_.reference - at_truth) ** 2
+        if args.rest_share:
+            totals.append(rest_share(ident, k, trace))
+            print(
+                f"{j:>3} eq. 3 without the rule {1e3 * totals[-1][0]:7.2f}, in those rests {totals[-1][1]:4.2f}"
+            )
+            continue
         t, tc = whole.t, ident.reference_.t
         cells = []
         for a, b in itertools.pairwise(edges):
@@ -88,9 +111,29 @@ def main() -> None:
             k2[0] += 1e-5
             line += f" | floor {100 * float(whole.nrmse(hf.simulate(k2, noise=False).i_q)):.2f} %"
         print(line, flush=True)
-    if totals:
+    if args.rest_share and totals:
+        shares = [share for _, share in totals]
+        print(f"share of eq. 3 at the truth in the rests below the ring edge over {len(shares)} cases: "
+              f"median {float(np.median(shares)):.2f}, max {max(shares):.2f}")  # fmt: skip
+    elif totals:
         print(f"eq. 3 at the truth [1e-3 A^2] over {len(totals)} cases: sum {1e3 * sum(totals):.1f}, "
               f"median {1e3 * float(np.median(totals)):.2f}, max {1e3 * max(totals):.2f}")  # fmt: skip
+
+
+def rest_share(ident: FaultIdentifier, k: np.ndarray, trace: object) -> tuple[float, float]:
+    """Eq. 3 at the truth k without the rule for the rests below the ring edge, and the share of
+    it those rests hold (the samples `ident.mask_` leaves out and the rule before it kept)."""
+    monitor, f_s = ident.monitor_, ident.monitor_.params.controller.f_s
+    grid, theta = monitor.sample_grid(ident.duration_)
+    position = np.interp(grid, trace.t - trace.t[0], trace.theta_u)  # type: ignore[attr-defined]
+    before = moving_mask(theta, f_s, theta_u=position) * band_mask(theta, f_s)
+    fitness = Fitness(
+        ident.reference_, ident.slope_unit, before, error_weights(theta, f_s, ident.error_corner_hz_)
+    )
+    at_truth = ident.reference_.filtered(monitor.simulate(k, duration=ident.duration_).i_q)
+    cost = fitness.weights * (ident.reference_.reference - at_truth) ** 2
+    gone = (before > 0) & (ident.mask_ == 0)
+    return float(cost.sum()), float(cost[gone].sum() / cost.sum())
 
 
 def by_frequency() -> None:
