@@ -341,6 +341,38 @@ def test_the_loop_carries_the_demand_by_how_many_zero_vectors_hold():
     assert 0.0 < MAY_REST_CARRY < 1.0
 
 
+def test_a_stuck_monitor_carries_half_the_demand_in_the_ring():
+    """Inside `simulate_lf`: with the loop-error surrogate off (the motor carries the loop state),
+    a motor stuck where only one zero vector holds carries `MAY_REST_CARRY` of the demand."""
+
+    from emaphm.commands import Steps
+    from emaphm.faults import random_faults
+    from emaphm.kernels.monitor import IDX, MAY_REST_CARRY, N_AUX, simulate_lf, standstill_dead_zone
+
+    cal = default_calibration()
+    plain = dataclasses.replace(
+        cal.coefficients, k_H=0.0, delta_0=0.0, delta_1=0.0, delta_u=0.0, delta_2=0.0, i_R=0.0
+    )
+    monitor = MonitorEma(command=Steps(dwell=0.2), calibration=dataclasses.replace(cal, coefficients=plain))
+    # a random actuator whose motor sticks in the ring at the ends of dwells (bench_multifault's case 15)
+    row = monitor.rows(random_faults(20, 2611)[15][None, :])[0]
+    _, theta = monitor.sample_grid(None)
+    i_out, aux = np.zeros(len(theta)), np.zeros((len(theta), N_AUX))
+    simulate_lf(theta, row, i_out, aux)
+    omega, theta_e, demand = aux[:, 2], aux[:, 3], aux[:, 4]
+    carry = np.array(
+        [
+            standstill_dead_zone(d, w, np.sin(e), np.cos(e), row[IDX["i_D"]])
+            for d, w, e in zip(demand, omega, theta_e, strict=True)
+        ]
+    )
+    # samples a few loop time constants into a stretch of the ring
+    ring = np.array([k >= 5 and np.all(carry[k - 5 : k + 1] == MAY_REST_CARRY) for k in range(len(carry))])
+    assert ring.sum() > 100 and np.all(omega[ring] == 0.0)
+    np.testing.assert_allclose(i_out[ring], MAY_REST_CARRY * demand[ring], rtol=0, atol=1e-3)
+    assert np.min(np.abs(demand[ring])) > 0.04  # so neither the whole demand nor none would pass
+
+
 def test_no_zero_vector_holds_beyond_the_ring_edge_at_any_angle():
     import math
 
