@@ -46,8 +46,10 @@ def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, t
     assert np.all(np.delete(err, 6) < tol), err
     pop, gen = small_polish
     # the GA, the polish of its best point and of its runner-up, the final check of the shorts (8),
-    # and one more polish if a candidate fits better
-    assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8
+    # one more polish if a candidate fits better, and the least-squares polish (a Jacobian of 9
+    # rows per residual evaluation at most, and the final value)
+    ls = 1 + optimizers.LS_MAX_NFEV * (1 + 9) + 1
+    assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8 + ls
 
 
 def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
@@ -65,6 +67,18 @@ def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
         assert not np.array_equal(a, c)
         found[polish] = a
     assert not np.array_equal(found[True], found[False])  # the polish ran and moved the estimate
+
+
+def test_the_least_squares_polish_ends_the_identification_and_never_makes_it_worse(measured, monkeypatch):
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))  # a tiny search leaves it work to do
+    _, r = measured["friction+shortB"]
+    ident = FaultIdentifier("ga", seed=3, pop_size=16, generations=3).fit(r.t, r.i_q)
+    assert ident.least_squares_gain_ is not None and ident.least_squares_gain_ < 0.9
+    # the value kept is eq. (3) at the estimate, as the search computes it
+    at = ident.objective_.of_monitor(ident.monitor_, ident.faults_[None, :], duration=ident.duration_)[0]
+    assert ident.fitness_ == pytest.approx(float(at), rel=1e-9)
+    plain = FaultIdentifier("ga", seed=3, **TINY).fit(r.t, r.i_q)
+    assert plain.least_squares_gain_ is None  # no polish asked: none of either kind
 
 
 @pytest.mark.parametrize("name", OPTIMIZERS)

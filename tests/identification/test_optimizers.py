@@ -15,6 +15,7 @@ from emaphm.identification.optimizers import (
     BatchProblem,
     OptimizerRun,
     Stagnation,
+    least_squares_polish,
     minimize_batch,
     polish,
     run_optimizer,
@@ -181,3 +182,48 @@ def test_the_polish_never_returns_a_worse_point():
     # and it improves a start away from the minimum
     away = starts[0]
     assert polish(bowl, away, seed=1).f < 1e-2 * away.f
+
+
+def banana(X):
+    """Residuals of a curved valley in the unit box (Rosenbrock's, shifted): minimum 0 at
+    (0.8, 0.64), reached along x1 = x0²; the other six coordinates sit in a bowl at CENTRE."""
+    X = np.atleast_2d(X)
+    return np.column_stack([10.0 * (X[:, 1] - X[:, 0] ** 2), 0.8 - X[:, 0], X[:, 2:] - CENTRE[2:]])
+
+
+def sum_sq(R):
+    return np.sum(R**2, axis=1)
+
+
+def test_the_least_squares_polish_follows_a_curved_valley_and_never_returns_worse():
+    x0 = np.array([0.3, 0.09, *CENTRE[2:]])  # on the valley's floor, far from its minimum
+    start = OptimizerRun(x0, float(sum_sq(banana(x0))[0]), 5, [1.0])
+    run = least_squares_polish(banana, start)
+    assert run.f < 1e-6 * start.f and np.allclose(run.x[:2], [0.8, 0.64], atol=1e-3)
+    assert run.f == pytest.approx(float(sum_sq(banana(run.x))[0]), rel=1e-9, abs=1e-15)
+    assert 5 < run.evaluations <= 5 + (1 + 9) * 30 and run.history[:1] == start.history
+    # the CMA-ES polish on the same objective, the same number of evaluations, stops short of it
+    cma = polish(lambda X: sum_sq(banana(X)), start, seed=1, budget=(8, max((run.evaluations - 5) // 8, 2)))
+    assert cma.f > 100 * run.f
+    # a start at the minimum is kept; so is one whose value is already better than any it finds
+    best = np.array([0.8, 0.64, *CENTRE[2:]])
+    kept = least_squares_polish(banana, OptimizerRun(best, 0.0, 0, []))
+    assert kept.f == 0.0 and np.array_equal(kept.x, best)
+    lower = least_squares_polish(banana, OptimizerRun(x0, -1.0, 0, []))
+    assert lower.f == -1.0 and np.array_equal(lower.x, x0) and lower.evaluations > 0
+
+
+def test_the_least_squares_polish_survives_residuals_that_are_not_finite():
+    def holes(X):
+        R = banana(X)
+        R[np.atleast_2d(X)[:, 0] > 0.7, 0] = np.nan  # the way to the minimum crosses a hole
+        return R
+
+    x0 = np.array([0.3, 0.09, *CENTRE[2:]])
+    start = OptimizerRun(x0, float(sum_sq(banana(x0))[0]), 0, [])
+    run = least_squares_polish(holes, start)
+    assert np.isfinite(run.f) and run.f <= start.f and run.x[0] <= 0.7
+    # a start whose own residual is not finite is returned as it is
+    bad = OptimizerRun(np.array([0.75, 0.5, *CENTRE[2:]]), 1.0, 3, [1.0])
+    kept = least_squares_polish(holes, bad)
+    assert np.array_equal(kept.x, bad.x) and kept.f == 1.0 and kept.evaluations == 4

@@ -40,6 +40,8 @@ from ..errors import InputError
 
 __all__ = [
     "DEFAULT_BUDGETS",
+    "LS_MAX_NFEV",
+    "LS_STEP",
     "OPTIMIZERS",
     "POLISH_BUDGET",
     "BatchProblem",
@@ -48,12 +50,15 @@ __all__ = [
     "RelativeObjectiveTermination",
     "Stagnation",
     "check_optimizer",
+    "least_squares_polish",
     "minimize_batch",
     "polish",
     "run_optimizer",
 ]
 
 Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+# a batch of residual vectors: X (m, n) -> R (m, p), with the objective Σ_j R[i, j]² per row
+Residuals = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 OnGeneration = Callable[[int, int, float], None]  # (generation, max generations, best value)
 
 OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo")
@@ -69,6 +74,11 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "gwo": (64, 60),
 }
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
+
+# The least-squares polish (`least_squares_polish`): the forward-difference step of its Jacobian in
+# the unit box, and its budget of residual evaluations (each Jacobian costs n + 1 more, in one batch)
+LS_STEP = 1e-2
+LS_MAX_NFEV = 30
 
 
 @dataclass(frozen=True)
@@ -375,3 +385,63 @@ def polish(
     if not f < start.f:
         x, f = start.x, start.f
     return OptimizerRun(x, f, start.evaluations + problem.evaluations, [*start.history, *history])
+
+
+def least_squares_polish(
+    residuals: Residuals,
+    start: OptimizerRun,
+    *,
+    step: float = LS_STEP,
+    max_nfev: int = LS_MAX_NFEV,
+) -> OptimizerRun:
+    """Refine a point by nonlinear least squares on its residual vector (scipy's trust-region
+    reflective `least_squares` within the unit box), the objective being Σ r².
+
+    Where the fitness is a long curved valley in several faults at once, the CMA-ES polish stops
+    before its end: measured on a random case (bench_multifault, seed 2027, case 15 seed 2) a run
+    ended with the eccentricity at 0.020 against 0.047, at 1.23x the best fitness other seeds
+    found, with the fitness falling all along the straight line to their point; this polish went
+    there in 84 evaluations. The Jacobian is taken by forward differences of `step` in one batch
+    of n + 1 rows (backward at the upper bound). Keeps the start if the polish does not improve
+    on it, or fails (a residual that is not finite is replaced by a large one, so such a step is
+    rejected). The history continues the start's.
+    """
+    x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
+    n = len(x0)
+    count = [0]
+    scale = [1.0]
+
+    def batch(X: NDArray[np.float64]) -> NDArray[np.float64]:
+        count[0] += len(X)
+        R = np.asarray(residuals(X), dtype=np.float64)
+        return np.where(np.isfinite(R), R, 1e3 * scale[0])
+
+    def fun(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return batch(x[None, :])[0]
+
+    def jac(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        h = np.where(x + step <= 1.0, step, -step)
+        X = np.repeat(x[None, :], n + 1, axis=0)
+        X[np.arange(1, n + 1), np.arange(n)] += h
+        R = batch(X)
+        return ((R[1:] - R[0]) / h[:, None]).T  # type: ignore[no-any-return]
+
+    from scipy.optimize import least_squares
+
+    count[0] += 1
+    r0 = np.asarray(residuals(x0[None, :]), dtype=np.float64)[0]
+    if not np.all(np.isfinite(r0)):
+        return OptimizerRun(start.x, start.f, start.evaluations + 1, start.history)
+    scale[0] = max(float(np.max(np.abs(r0))), 1e-12)
+    try:
+        res = least_squares(
+            fun, x0, jac=jac, bounds=(np.zeros(n), np.ones(n)), method="trf", x_scale=np.full(n, 0.05),
+            max_nfev=max_nfev,
+        )  # fmt: skip
+    except (ValueError, np.linalg.LinAlgError):
+        return OptimizerRun(start.x, start.f, start.evaluations + count[0], start.history)
+    f = 2.0 * float(res.cost)
+    evaluations = start.evaluations + count[0]
+    if not f < start.f:
+        return OptimizerRun(start.x, start.f, evaluations, start.history)
+    return OptimizerRun(np.asarray(res.x, dtype=np.float64), f, evaluations, [*start.history, f])
