@@ -5,7 +5,8 @@ our own, vectorised and seeded. Every optimiser takes the same batch objective
 ``evaluate(X: (m, n)) -> (m,)``, stops at its generation budget or earlier when the best value has
 stagnated (`Stagnation`), reports each generation to a callback, and returns an `OptimizerRun`.
 The local polish (on by default in `identify`) refines the best point with a small CMA-ES, also
-one batch per generation.
+one batch per generation; `least_squares_polish` ends it with scipy's bounded least squares on the
+residual vector, its Jacobian one batch per iteration.
 
 The pieces shared with the calibration (`calibrate.py`): `BatchProblem` (the pymoo problem of a
 batch objective on a box; it counts evaluations and turns any non-finite value into +inf) and
