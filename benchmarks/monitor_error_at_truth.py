@@ -78,7 +78,7 @@ def main() -> None:
     print(
         f"command {args.command}, windows of {args.window:g} s: error / HF RMS [mA] and share of eq. 3 at the truth"
     )
-    totals: list[float] = []
+    totals: list = []  # eq. 3 per case, or (eq. 3, share) with --rest-share
     for j, k in enumerate(cases):
         if only is not None and j not in only:
             continue
@@ -123,16 +123,18 @@ def main() -> None:
 def rest_share(ident: FaultIdentifier, k: np.ndarray, trace: object) -> tuple[float, float]:
     """Eq. 3 at the truth k without the rule for the rests below the ring edge, and the share of
     it those rests hold (the samples `ident.mask_` leaves out and the rule before it kept)."""
+    # over the whole recording: the rule may end the compared span earlier (a final rest)
     monitor, f_s = ident.monitor_, ident.monitor_.params.controller.f_s
-    grid, theta = monitor.sample_grid(ident.duration_)
+    whole = ident.whole_ if ident.whole_ is not None else ident.reference_
+    grid, theta = monitor.sample_grid(float(whole.t[-1] - whole.t[0]))
     position = np.interp(grid, trace.t - trace.t[0], trace.theta_u)  # type: ignore[attr-defined]
     before = moving_mask(theta, f_s, theta_u=position) * band_mask(theta, f_s)
-    fitness = Fitness(
-        ident.reference_, ident.slope_unit, before, error_weights(theta, f_s, ident.error_corner_hz_)
-    )
-    at_truth = ident.reference_.filtered(monitor.simulate(k, duration=ident.duration_).i_q)
-    cost = fitness.weights * (ident.reference_.reference - at_truth) ** 2
-    gone = (before > 0) & (ident.mask_ == 0)
+    after = np.zeros_like(before)
+    after[: len(ident.mask_)] = ident.mask_
+    fitness = Fitness(whole, ident.slope_unit, before, error_weights(theta, f_s, ident.error_corner_hz_))
+    at_truth = whole.filtered(monitor.simulate(k, duration=float(grid[-1] - grid[0])).i_q)
+    cost = fitness.weights * (whole.reference - at_truth) ** 2
+    gone = (before > 0) & (after == 0)
     return float(cost.sum()), float(cost[gone].sum() / cost.sum())
 
 

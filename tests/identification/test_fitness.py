@@ -117,6 +117,7 @@ def test_the_moving_mask_leaves_out_rests_whose_current_is_below_the_ring_edge()
     # off without a current or an edge, and a command that never holds keeps every sample
     assert np.array_equal(moving_mask(steps, f_s, theta_u=position, i_meas=small), base)
     assert np.array_equal(moving_mask(steps, f_s, theta_u=position, rest_current=edge), base)
+    assert np.array_equal(moving_mask(steps, f_s, i_meas=small, rest_current=edge), moving_mask(steps, f_s))
     chirp = Chirp()(t)
     assert np.all(moving_mask(chirp, f_s, theta_u=np.zeros_like(t), i_meas=0 * t, rest_current=edge) == 1.0)
     with pytest.raises(ValueError, match="i_meas"):

@@ -77,6 +77,13 @@ def test_the_least_squares_polish_ends_the_identification_and_never_makes_it_wor
     # the value kept is eq. (3) at the estimate, as the search computes it
     at = ident.objective_.of_monitor(ident.monitor_, ident.faults_[None, :], duration=ident.duration_)[0]
     assert ident.fitness_ == pytest.approx(float(at), rel=1e-9)
+    # and the residuals it works on are eq. (3)'s: Σ r² equals the search's fitness row by row
+    from emaphm.identification.identify import search_to_faults
+
+    X = np.random.default_rng(0).uniform(0.0, 0.6, (3, 8))
+    R = ident.residuals()(X)
+    f = ident.objective_.of_monitor(ident.monitor_, search_to_faults(X), duration=ident.duration_)
+    np.testing.assert_allclose(np.sum(R**2, axis=1), f, rtol=1e-9)
     plain = FaultIdentifier("ga", seed=3, **TINY).fit(r.t, r.i_q)
     assert plain.least_squares_gain_ is None  # no polish asked: none of either kind
 

@@ -213,6 +213,19 @@ def test_the_least_squares_polish_follows_a_curved_valley_and_never_returns_wors
     assert lower.f == -1.0 and np.array_equal(lower.x, x0) and lower.evaluations > 0
 
 
+def test_the_least_squares_polish_reaches_a_minimum_on_the_upper_bound():
+    def edge(X):  # minimum 0 at x0 = 1 (the box's bound), the rest at CENTRE; undefined beyond
+        X = np.atleast_2d(X)
+        R = np.column_stack([1.0 - X[:, 0], X[:, 1:] - CENTRE[1:]])
+        R[X[:, 0] > 1.0] = np.nan
+        return R
+
+    x0 = np.array([0.98, *CENTRE[1:]])
+    start = OptimizerRun(x0, float(sum_sq(edge(x0))[0]), 0, [])
+    run = least_squares_polish(edge, start)  # within a step of the bound: the backward difference
+    assert run.x[0] == pytest.approx(1.0, abs=1e-3) and run.f < 1e-3 * start.f
+
+
 def test_the_least_squares_polish_survives_residuals_that_are_not_finite():
     def holes(X):
         R = banana(X)

@@ -102,7 +102,8 @@ def moving_mask(
     those dwells stay whole (the surface hunts through a staircase's 0.2 s dwells). With the
     measured current `i_meas` [A] (filtered, on the same grid) a sample of a hold is also left out
     once the surface has rested for `REST_SETTLE_S` and |i_meas| < `rest_current` [A] (the
-    identification passes the monitor's ring edge, `kernels.monitor.RING_OUTER` · i_D; 0: off).
+    identification passes the monitor's ring edge, `kernels.monitor.RING_OUTER` · i_D; 0: off;
+    off too without `theta_u`, which alone says the surface rests).
 
     Where the surface rests, it sits wherever stick-slip left it, and the position loop's
     integrator ramps the current against that small error: the held current depends on the

@@ -37,7 +37,15 @@ from ..params import EmaParams
 from ..results import SimResult
 from .coverage import command_warnings
 from .detection import detect, load_thresholds
-from .fitness import BAND_HZ, ERROR_CORNER_HZ, Fitness, band_mask, error_weights, moving_mask
+from .fitness import (
+    BAND_HZ,
+    ERROR_CORNER_HZ,
+    REST_SETTLE_S,
+    Fitness,
+    band_mask,
+    error_weights,
+    moving_mask,
+)
 from .metrics import absolute_errors, percent_error, wrap_phase
 from .optimizers import (
     POLISH_BUDGET,
@@ -293,9 +301,16 @@ class FaultIdentifier:
         )
         kept = np.flatnonzero(mask)
         if len(kept) < MIN_SAMPLES:
+            small_rests = (
+                f" (a rest at under {1e3 * rest_current:.0f} mA is left out {1e3 * REST_SETTLE_S:g} ms "
+                "after the surface stops)"
+                if rest_current > 0 and position is not None
+                else ""
+            )
             raise InputError(
                 f"only {len(kept)} samples of the recording can be compared (at least {MIN_SAMPLES} are needed): "
-                f"the others are rests in a hold, or a command faster than the {BAND_HZ:g} Hz the monitor was fitted on"
+                f"the others are rests in a hold{small_rests}, or a command faster than the "
+                f"{BAND_HZ:g} Hz the monitor was fitted on"
             )
         corner = resolve_error_corner(self.error_corner_hz, monitor.monitor)
         emphasis = error_weights(theta_grid, f_s, corner)
@@ -371,13 +386,9 @@ class FaultIdentifier:
             self.fit_nrmse_ = float("inf")
         return self
 
-    def _least_squares(
-        self, evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]], run: OptimizerRun
-    ) -> tuple[OptimizerRun, float]:
-        """The last polish: least squares on eq. (3)'s residual vector (`least_squares_polish`),
-        r = √w·(I_ref − I_LF) over the compared samples, from the representative of k7 inside the
-        box. Returns the run (its value from `evaluate`, the search's own numbers) and the
-        fitness ratio it gave (1.0: the run was kept)."""
+    def residuals(self) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+        """Eq. (3)'s residual vectors r = √w·(I_ref − I_LF) over the compared samples for rows X
+        in the search box (after `prepare`): Σ r² per row is ``objective_`` of those faults."""
         monitor, duration, fitness = self.monitor_, self.duration_, self.objective_
         keep = np.flatnonzero(fitness.weights > 0)
         root_w = np.sqrt(fitness.weights[keep])
@@ -387,14 +398,23 @@ class FaultIdentifier:
             currents = monitor.simulate_many(search_to_faults(X), duration=duration, check=False)
             return root_w * (reference - self.reference_.filtered(currents)[:, keep])  # type: ignore[no-any-return]
 
-        polished = least_squares_polish(residuals, recentre_phase(run))
+        return residuals
+
+    def _least_squares(
+        self, evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]], run: OptimizerRun
+    ) -> tuple[OptimizerRun, float]:
+        """The last polish: least squares on eq. (3)'s residual vector (`least_squares_polish`),
+        r = √w·(I_ref − I_LF) over the compared samples, from the representative of k7 inside the
+        box. Returns the run (its value from `evaluate`, the search's own numbers) and the
+        fitness ratio it gave (1.0: the run was kept)."""
+        polished = least_squares_polish(self.residuals(), recentre_phase(run))
         if not polished.f < run.f:
             return OptimizerRun(run.x, run.f, polished.evaluations, run.history), 1.0
         f = float(evaluate(polished.x[None, :])[0])
         if not f < run.f:  # the same numbers to 1e-12; guard against a row that diverges here
             return OptimizerRun(run.x, run.f, polished.evaluations + 1, run.history), 1.0
-        history = [*run.history, f]
-        return OptimizerRun(polished.x, f, polished.evaluations + 1, history), f / run.f
+        # the history stays the search's and the CMA-ES polish's: one value per generation
+        return OptimizerRun(polished.x, f, polished.evaluations + 1, run.history), f / run.f
 
     def curves(self) -> dict[str, NDArray[np.float64]]:
         """The fit as curves on the model grid over the whole recording: ``t`` [s], the filtered
@@ -830,7 +850,8 @@ def identify(
         "short_check": ident.short_move_,
         # the restart of an eccentricity trapped at zero ("eccentricity from k7 = ..."; None: kept)
         "eccentricity_check": ident.eccentricity_move_,
-        # the fitness ratio the last, least-squares polish gave (1.0: kept; None: no polish)
+        # the fitness ratio the last, least-squares polish gave (1.0: its point rejected, the
+        # previous one kept; None: no polish)
         "least_squares_gain": ident.least_squares_gain_,
         # the fraction of samples the fitness compares (long holds of the command are left out)
         "samples_compared": round(ident.compared_, 4),

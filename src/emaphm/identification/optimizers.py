@@ -404,8 +404,9 @@ def least_squares_polish(
     found, with the fitness falling all along the straight line to their point; this polish went
     there in 84 evaluations. The Jacobian is taken by forward differences of `step` in one batch
     of n + 1 rows (backward at the upper bound). Keeps the start if the polish does not improve
-    on it, or fails (a residual that is not finite is replaced by a large one, so such a step is
-    rejected). The history continues the start's.
+    on it, or fails. A residual that is not finite is replaced by a large one: a trial point that
+    diverges is rejected; a Jacobian probe that diverges spoils its column, and the step it
+    proposes then rarely fits better, so the start is kept. The history continues the start's.
     """
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
     n = len(x0)
