@@ -408,42 +408,46 @@ def least_squares_polish(
     diverges is rejected; a Jacobian probe that diverges spoils its column, and the step it
     proposes then rarely fits better, so the start is kept. The history continues the start's.
     """
+    from scipy.optimize import least_squares
+
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
     n = len(x0)
-    count = [0]
-    scale = [1.0]
+    evaluations = 0
 
     def batch(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        count[0] += len(X)
-        R = np.asarray(residuals(X), dtype=np.float64)
-        return np.where(np.isfinite(R), R, 1e3 * scale[0])
+        nonlocal evaluations
+        evaluations += len(X)
+        return np.asarray(residuals(X), dtype=np.float64)
+
+    r0 = batch(x0[None, :])[0]
+    if not np.all(np.isfinite(r0)):
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
+    big = 1e3 * max(float(np.max(np.abs(r0))), 1e-12)
+
+    def finite(R: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.where(np.isfinite(R), R, big)
 
     def fun(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        return batch(x[None, :])[0]
+        # scipy evaluates its start once more: that is r0 again
+        return finite(r0 if np.array_equal(x, x0) else batch(x[None, :])[0])
 
     def jac(x: NDArray[np.float64]) -> NDArray[np.float64]:
         h = np.where(x + step <= 1.0, step, -step)
         X = np.repeat(x[None, :], n + 1, axis=0)
         X[np.arange(1, n + 1), np.arange(n)] += h
-        R = batch(X)
+        R = finite(batch(X))
         return ((R[1:] - R[0]) / h[:, None]).T  # type: ignore[no-any-return]
 
-    from scipy.optimize import least_squares
-
-    count[0] += 1
-    r0 = np.asarray(residuals(x0[None, :]), dtype=np.float64)[0]
-    if not np.all(np.isfinite(r0)):
-        return OptimizerRun(start.x, start.f, start.evaluations + 1, start.history)
-    scale[0] = max(float(np.max(np.abs(r0))), 1e-12)
     try:
         res = least_squares(
             fun, x0, jac=jac, bounds=(np.zeros(n), np.ones(n)), method="trf", x_scale=np.full(n, 0.05),
             max_nfev=max_nfev,
         )  # fmt: skip
     except (ValueError, np.linalg.LinAlgError):
-        return OptimizerRun(start.x, start.f, start.evaluations + count[0], start.history)
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
     f = 2.0 * float(res.cost)
-    evaluations = start.evaluations + count[0]
     if not f < start.f:
-        return OptimizerRun(start.x, start.f, evaluations, start.history)
-    return OptimizerRun(np.asarray(res.x, dtype=np.float64), f, evaluations, [*start.history, f])
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
+    return OptimizerRun(
+        np.asarray(res.x, dtype=np.float64), f, start.evaluations + evaluations, [*start.history, f]
+    )
