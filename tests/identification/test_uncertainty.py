@@ -283,3 +283,29 @@ def test_non_finite_details_become_null_in_json():
     )
     assert u.to_json()["uq"]["autocorr_time"] == [None, 3.0]
     json.dumps(u.to_json(), allow_nan=False)
+
+
+@pytest.mark.parametrize(("n", "half"), [(50, 0), (50, 3), (1000, 40), (10001, 316), (200, 199)])
+def test_the_sandwich_convolution_is_fftconvolves_same(n, half):
+    from scipy.signal import fftconvolve
+
+    from emaphm.identification.uncertainty import _convolve_same
+
+    rng = np.random.default_rng(n + half)
+    g = rng.normal(size=(n, 3))
+    kernel = 1.0 - np.abs(np.arange(-half, half + 1)) / (half + 1)
+    want = fftconvolve(g, kernel[:, None], mode="same", axes=0)
+    got = _convolve_same(g, kernel)
+    assert got.shape == g.shape
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+    # and against the definition, a direct sum (independent of any FFT)
+    direct = np.array(
+        [
+            [
+                sum(kernel[half + j - i] * g[i, c] for i in range(max(0, j - half), min(n, j + half + 1)))
+                for c in range(3)
+            ]
+            for j in range(0, n, max(1, n // 7))
+        ]
+    )
+    np.testing.assert_allclose(got[:: max(1, n // 7)], direct, rtol=0, atol=1e-12 * np.max(np.abs(want)))

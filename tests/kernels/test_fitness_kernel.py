@@ -9,8 +9,8 @@ from scipy.signal import butter, sosfilt_zi, sosfiltfilt
 from emaphm import MonitorEma
 from emaphm._threads import numba_threads
 from emaphm.identification import identify as identify_module
-from emaphm.identification.fitness import Fitness, sosfiltfilt_padlen
-from emaphm.identification.signals import Comparison
+from emaphm.identification.fitness import Fitness
+from emaphm.identification.signals import Comparison, sosfiltfilt_padlen
 from emaphm.kernels.fitness import filtered_fitness, fitness_lf_many, pairwise_sum
 from emaphm.kernels.monitor import IDX
 

@@ -24,11 +24,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import maximum_filter1d
-from scipy.signal import butter, sosfilt_zi
 
 from ..errors import InputError
 from ..kernels.fitness import fitness_lf_many
-from .signals import CUTOFF_HZ, FILTER_ORDER, Comparison
+from .signals import Comparison, comparison_filter
 
 if TYPE_CHECKING:
     from ..models import MonitorEma
@@ -294,9 +293,7 @@ class Fitness:
                 raise ValueError("emphasis must be finite and >= 0")
             self.weights = self.weights * e
         # the comparison filter (`signals.lowpass`) for the fused kernel: sosfiltfilt's defaults
-        self.sos: NDArray[np.float64] = butter(FILTER_ORDER, CUTOFF_HZ, fs=reference.f_s, output="sos")
-        self.zi: NDArray[np.float64] = sosfilt_zi(self.sos)
-        self.padlen = sosfiltfilt_padlen(self.sos)
+        self.sos, self.zi, self.padlen = comparison_filter(reference.f_s)
 
     def __call__(self, currents: ArrayLike) -> NDArray[np.float64]:
         residual = self.reference.reference - self.reference.filtered(currents)
@@ -322,9 +319,3 @@ class Fitness:
         out = np.empty(rows.shape[0])
         fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out)
         return out
-
-
-def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
-    """The edge `scipy.signal.sosfiltfilt` pads by default: 3·ntaps (9 for one biquad)."""
-    ntaps = 2 * sos.shape[0] + 1 - min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
-    return 3 * ntaps

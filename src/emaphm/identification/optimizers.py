@@ -22,6 +22,9 @@ Table 1 case). PCX is rotation-invariant and found the right basin in every seed
 
 from __future__ import annotations
 
+import sys
+import threading
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -274,9 +277,36 @@ def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng
     raise AssertionError(f"no pymoo algorithm for {name!r}")  # names are checked before
 
 
-def _cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int) -> Any:
-    from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+def _import_cmaes() -> Any:
+    """pymoo's CMAES class, imported without matplotlib.
 
+    The `cma` package it wraps imports ``matplotlib.pyplot`` when it is imported (``cma.s``, for
+    its plots, which emaphm never calls): 0.35 s of every ``emaphm identify`` on the machines of
+    BENCHMARKS.md. While `cma` is first imported, matplotlib is made unimportable (None in
+    ``sys.modules``, which `cma` catches: its plots say "not available"), then put back. Only
+    when no other Python thread runs (another thread could import matplotlib meanwhile) and
+    matplotlib is not loaded already.
+    """
+    if "cma" in sys.modules or "matplotlib" in sys.modules or threading.active_count() > 1:
+        from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+
+        return CMAES
+    blocked = ("matplotlib", "matplotlib.pyplot")
+    for name in blocked:
+        sys.modules[name] = None  # type: ignore[assignment]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # cma's "Could not import matplotlib.pyplot"
+            from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+    finally:
+        for name in blocked:
+            if sys.modules.get(name, 0) is None:
+                del sys.modules[name]
+    return CMAES
+
+
+def _cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int) -> Any:
+    CMAES = _import_cmaes()
     # pymoo passes the generation budget on to the `cma` package only when the termination is a
     # bare MaximumGenerationTermination; give it explicitly, as it is combined with the early stop
     return CMAES(x0=x0, sigma=sigma, popsize=pop_size, restarts=0, maxiter=generations)

@@ -4,8 +4,13 @@ Both signals (the measured or HF i_q and the LF current) go through the same zer
 filter on the same time grid before they are compared:
 
 - **filter**: 2nd-order Butterworth at 150 Hz (*choice*), applied forward and backward
-  (`scipy.signal.sosfiltfilt`): zero phase, so no lag between the signals; it keeps the 1θ_e and
-  2θ_e fault harmonics (≤ 80 Hz on the FDI chirp) and removes the hysteresis ripple (kHz).
+  (``scipy.signal.sosfiltfilt``'s numbers): zero phase, so no lag between the signals; it keeps
+  the 1θ_e and 2θ_e fault harmonics (≤ 80 Hz on the FDI chirp) and removes the hysteresis ripple
+  (kHz). The one biquad is designed here (`butterworth2`, `biquad_zi`) and run by the numba
+  kernel `kernels.fitness.sosfiltfilt_many`, the same numbers as ``butter``, ``sosfilt_zi`` and
+  ``sosfiltfilt`` to the last bit (tests), because importing ``scipy.signal`` costs 0.9 s
+  (scipy 1.17 loads all of it, ``scipy.stats`` included) on every ``emaphm identify``, whose
+  goal is 2 s in all; the order-8 anti-aliasing filter of `resample` still imports it.
 - **grid**: the LF model's sample grid t_k = k/f_s; a reference trace on another grid is
   interpolated onto it (`Comparison.from_trace`, `resample`), after an anti-aliasing low-pass on
   its own grid when it is sampled faster.
@@ -19,25 +24,91 @@ filter on the same time grid before they are compared:
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import butter, sosfiltfilt
 
 from ..errors import InputError
+from ..kernels.fitness import sosfiltfilt_many
 
-__all__ = ["CUTOFF_HZ", "FILTER_ORDER", "Comparison", "lowpass", "nrmse", "resample"]
+__all__ = [
+    "CUTOFF_HZ",
+    "FILTER_ORDER",
+    "Comparison",
+    "biquad_zi",
+    "butterworth2",
+    "comparison_filter",
+    "lowpass",
+    "nrmse",
+    "resample",
+    "sosfiltfilt_padlen",
+]
 
 CUTOFF_HZ = 150.0
 FILTER_ORDER = 2
 
 
+def butterworth2(cutoff: float, f_s: float) -> NDArray[np.float64]:
+    """The digital 2nd-order Butterworth low-pass at `cutoff` [Hz] for rate `f_s` [Hz] as one
+    second-order section [[b0, b1, b2, 1, a1, a2]]: ``scipy.signal.butter(2, cutoff, fs=f_s,
+    output="sos")``, computed in the same steps (analogue poles −ω_w·e^(±jπ/4) at the pre-warped
+    ω_w = 4·tan(π·W/2), W = 2·cutoff/f_s; bilinear transform at 2·fs = 4; the two zeros at z = −1),
+    so the same numbers to the last bit (tested over rates and cutoffs)."""
+    cutoff, f_s = float(cutoff), float(f_s)
+    if not (math.isfinite(cutoff) and math.isfinite(f_s) and 0.0 < cutoff < f_s / 2.0):
+        raise ValueError(f"the cutoff must lie in (0, f_s/2) = (0, {f_s / 2:g}) Hz, got {cutoff:g}")
+    warped = 4.0 * np.tan(np.pi * (2.0 * cutoff / f_s) / 2.0)
+    p = -np.exp(1j * np.pi * np.array([-1.0, 1.0]) / 4.0) * warped
+    p_z = (4.0 + p) / (4.0 - p)
+    k_z = warped**2 * np.real(1.0 / np.prod(4.0 - p))
+    a = np.real(np.poly(p_z))
+    return np.array([[k_z, 2.0 * k_z, k_z, a[0], a[1], a[2]]])
+
+
+def biquad_zi(sos: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``scipy.signal.sosfilt_zi`` of one section (a0 = 1): the state of direct form II transposed
+    after a unit step has settled, (I − Aᵀ)·zi = b[1:] − a[1:]·b0 with A the companion of a."""
+    if sos.shape != (1, 6) or sos[0, 3] != 1.0:
+        raise ValueError(f"one normalised second-order section is needed, got shape {sos.shape}")
+    b0, b1, b2, _, a1, a2 = sos[0]
+    i_minus_a = np.array([[1.0 + a1, -1.0], [a2, 1.0]])
+    return np.linalg.solve(i_minus_a, np.array([b1 - a1 * b0, b2 - a2 * b0]))[None, :]  # type: ignore[no-any-return]
+
+
+@functools.lru_cache(maxsize=16)
+def comparison_filter(
+    f_s: float, cutoff: float = CUTOFF_HZ
+) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
+    """The comparison filter for rate `f_s`: (sos, zi, pad), pad = ``sosfiltfilt``'s default edge
+    (9 samples). Read-only arrays (cached)."""
+    sos = butterworth2(cutoff, f_s)
+    zi = biquad_zi(sos)
+    sos.flags.writeable = False
+    zi.flags.writeable = False
+    return sos, zi, sosfiltfilt_padlen(sos)
+
+
+def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
+    """The edge `scipy.signal.sosfiltfilt` pads by default: 3·ntaps (9 for one biquad)."""
+    ntaps = 2 * sos.shape[0] + 1 - min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
+    return 3 * ntaps
+
+
 def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = -1) -> NDArray[np.float64]:
-    """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`."""
-    sos = butter(FILTER_ORDER, cutoff, fs=f_s, output="sos")
-    return sosfiltfilt(sos, np.asarray(x, dtype=np.float64), axis=axis)
+    """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`: the numbers of
+    ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``."""
+    sos, zi, pad = comparison_filter(float(f_s), float(cutoff))
+    a = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
+    n = a.shape[-1]
+    if n <= pad:
+        raise ValueError(f"the filter needs more than {pad} samples, got {n}")
+    rows = np.ascontiguousarray(a.reshape(-1, n))
+    out = np.empty_like(rows)
+    sosfiltfilt_many(rows, sos, zi, pad, out)
+    return np.moveaxis(out.reshape(a.shape), -1, axis)
 
 
 def nrmse(reference: ArrayLike, estimate: ArrayLike, *, axis: int = -1) -> NDArray[np.float64] | float:
@@ -78,6 +149,8 @@ def resample(t_src: ArrayLike, x_src: ArrayLike, t_grid: ArrayLike, f_s: float) 
         uniform = bool(np.max(np.abs(dt - step)) <= 1e-3 * step)
         f_src = 1.0 / step
         if uniform and f_src > ANTI_ALIAS_ABOVE * f_s:
+            from scipy.signal import butter, sosfiltfilt  # 0.9 s to import: only here
+
             cutoff = ANTI_ALIAS_FRACTION * f_s
             sos = butter(ANTI_ALIAS_ORDER, cutoff, fs=f_src, output="sos")
             if len(x) > 3 * (2 * len(sos) + 1):  # sosfiltfilt's default padding
