@@ -102,19 +102,19 @@ def test_lowpass_refuses_a_signal_the_filter_cannot_pad():
     np.testing.assert_allclose(lowpass(np.ones(10), 1e4), np.ones(10), rtol=1e-12)  # DC passes
 
 
-def test_an_identification_imports_neither_scipy_signal_nor_matplotlib():
-    # their imports cost 0.9 s (scipy 1.17 loads all of scipy.signal) and 0.35 s (`cma` imports
-    # matplotlib.pyplot) of every `emaphm identify`; the whole default path: GA, CMA-ES polish,
-    # least squares, Laplace intervals
+def test_an_identification_imports_neither_scipy_signal_nor_matplotlib_nor_scipy_stats():
+    # their imports cost 0.9 s (scipy 1.17 loads all of scipy.signal), 0.35 s and 0.46 s (`cma`
+    # imports matplotlib.pyplot and scipy.stats) of every `emaphm identify`; the whole default
+    # path: GA, CMA-ES polish, least squares, Laplace intervals
     code = (
         "import sys\n"
         "from emaphm.identification.identify import identify\n"
         "r = identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=2, pop_size=8)\n"
         "assert r.uncertainty is not None and r.settings['least_squares_gain'] is not None\n"
-        "print([m for m in ('scipy.signal', 'matplotlib') if m in sys.modules])\n"
-        "import matplotlib.pyplot\n"  # and matplotlib is importable afterwards
-        "print(matplotlib.pyplot.__name__)\n"
+        "print([m for m in ('scipy.signal', 'matplotlib', 'scipy.stats') if m in sys.modules])\n"
+        "import matplotlib.pyplot, scipy.stats\n"  # and both are importable afterwards
+        "print(matplotlib.pyplot.__name__, scipy.stats.norm.cdf(0.0))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.split() == ["[]", "matplotlib.pyplot"]
+    assert out.stdout.split() == ["[]", "matplotlib.pyplot", "0.5"]
     assert "matplotlib" not in out.stderr  # cma's warning about it is not shown

@@ -287,20 +287,21 @@ def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng
 
 
 def _import_cmaes() -> Any:
-    """pymoo's CMAES class, imported without matplotlib.
+    """pymoo's CMAES class, imported without what `cma` loads for features emaphm never uses.
 
-    The `cma` package it wraps imports ``matplotlib.pyplot`` when it is imported (``cma.s``, for
-    its plots, which emaphm never calls): 0.35 s of every ``emaphm identify`` on the machines of
-    BENCHMARKS.md. While `cma` is first imported, matplotlib is made unimportable (None in
-    ``sys.modules``, which `cma` catches: its plots say "not available"), then put back. Only
-    when no other Python thread runs (another thread could import matplotlib meanwhile) and
-    matplotlib is not loaded already.
+    The `cma` package it wraps imports ``matplotlib.pyplot`` (``cma.s``, for its plots) and
+    ``scipy.stats`` (``cma.fitness_models``, for surrogate models; it has a fallback of its own)
+    when it is imported: 0.35 s and 0.46 s of every ``emaphm identify`` on machine A of
+    BENCHMARKS.md. While `cma` is first imported, those of them not loaded yet are made
+    unimportable (None in ``sys.modules``, which `cma` catches), then put back, so that anyone
+    can import them afterwards. Only when no other Python thread runs (another thread could
+    import them meanwhile).
     """
-    if "cma" in sys.modules or "matplotlib" in sys.modules or threading.active_count() > 1:
+    if "cma" in sys.modules or threading.active_count() > 1:
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
 
         return CMAES
-    blocked = ("matplotlib", "matplotlib.pyplot")
+    blocked = [name for name in CMA_UNUSED_IMPORTS if name not in sys.modules]
     for name in blocked:
         sys.modules[name] = None  # type: ignore[assignment]
     try:
@@ -309,9 +310,13 @@ def _import_cmaes() -> Any:
             from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
     finally:
         for name in blocked:
-            if sys.modules.get(name, 0) is None:
+            if name in sys.modules and sys.modules[name] is None:
                 del sys.modules[name]
     return CMAES
+
+
+# what `cma` imports at its own import for plots and surrogate models (`_import_cmaes`)
+CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
 
 
 def _cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int) -> Any:
