@@ -179,9 +179,9 @@ def test_the_polish_never_returns_a_worse_point():
     start = OptimizerRun(CENTRE + 0.05, -1.0, 7, [-1.0])
     run = polish(bowl, start, seed=1)
     assert run.f == -1.0 and np.array_equal(run.x, start.x) and run.evaluations > 7
-    # and it improves a start far from the minimum (a random point; 32 x 25 reach 1.1 % of it)
+    # and it improves a start away from the minimum
     away = starts[0]
-    assert polish(bowl, away, seed=1).f < 5e-2 * away.f
+    assert polish(bowl, away, seed=1).f < 1e-2 * away.f
 
 
 def banana(X):

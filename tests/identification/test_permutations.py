@@ -111,9 +111,7 @@ def test_polishing_the_runner_up_escapes_a_neighbouring_basin():
     population = np.array([A, A - 0.01, B + 0.05])
     run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
     out, won = polish_two(two_basins, run, seed=1)
-    # in the deep basin, far below the shallow one's floor (0.05); the least-squares polish that
-    # follows in `FaultIdentifier.fit` finishes the descent
-    assert won and out.f < 5e-3 and np.max(np.abs(out.x - B)) < 0.01
+    assert won and out.f < 1e-4 and np.max(np.abs(out.x - B)) < 0.01
     assert out.evaluations > 10 + 32 and out.history[0] == 1.0
     # when the best point's basin is the deep one, it stays
     swapped = OptimizerRun(B.copy(), 0.0, 10, [0.0], population[::-1], two_basins(population[::-1]))

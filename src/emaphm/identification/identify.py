@@ -48,7 +48,7 @@ from .fitness import (
 )
 from .metrics import absolute_errors, percent_error, wrap_phase
 from .optimizers import (
-    RESTART_POLISH_BUDGET,
+    POLISH_BUDGET,
     OnGeneration,
     OptimizerRun,
     Stagnation,
@@ -526,14 +526,11 @@ def try_eccentricity_directions(
         return OptimizerRun(run.x, run.f, evaluations, run.history), None
     probe = OptimizerRun(X[best], float(f[best]), evaluations, run.history)
     if polish_it:
-        # a whole polish budget (32 x 50), no early stop: from the restart the shorts must move
-        # together by ~0.06, and the usual stop (then 15 generations without gain) ended two runs
-        # of the chirp run on to 2 s at 1.47x and 1.71x the best known after 481 evaluations; the
-        # whole budget (1569) reached it on both, and on chirp case 9 s1 (scratch runs, BENCHMARKS.md)
-        probe = polish(
-            evaluate, probe, seed=seed, budget=RESTART_POLISH_BUDGET,
-            stagnation=Stagnation(patience=RESTART_POLISH_BUDGET[1]),
-        )  # fmt: skip
+        # the whole polish budget, no early stop: from the restart the shorts must move together by
+        # ~0.06, and the usual stop (15 generations without gain) ended two runs of the chirp run on
+        # to 2 s at 1.47x and 1.71x the best known after 481 evaluations; the whole budget (1569)
+        # reached it on both, and on chirp case 9 s1 (scratch runs, BENCHMARKS.md)
+        probe = polish(evaluate, probe, seed=seed, stagnation=Stagnation(patience=POLISH_BUDGET[1]))
     if not probe.f < ECC_PROBE_GAIN * run.f:
         return OptimizerRun(run.x, run.f, probe.evaluations, run.history), None
     return probe, f"eccentricity from k7 = {directions[best]:g}"

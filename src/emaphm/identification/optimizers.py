@@ -48,8 +48,6 @@ __all__ = [
     "LS_STEP",
     "OPTIMIZERS",
     "POLISH_BUDGET",
-    "POLISH_PATIENCE",
-    "RESTART_POLISH_BUDGET",
     "BatchProblem",
     "GenerationLog",
     "OptimizerRun",
@@ -79,14 +77,7 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "cmaes": (64, 60),
     "gwo": (64, 60),
 }
-# the CMA-ES polish: population, generations, and its early stop (generations without a gain of
-# 0.1 %). The least-squares polish ends the search since 99ebbf9: (32, 25) stopped at 8 gave the
-# same fitness as (32, 50) at 15 (+0.2 to +0.8 % summed over 22 scratch runs) for 26 % fewer
-# evaluations (BENCHMARKS.md, "A shorter CMA-ES polish"); a population of 16 left a wrong basin
-POLISH_BUDGET = (32, 25)
-POLISH_PATIENCE = 8
-# the polish of the eccentricity check's restart (`identify.try_eccentricity_directions`): whole, no early stop
-RESTART_POLISH_BUDGET = (32, 50)
+POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
 
 # The least-squares polish (`least_squares_polish`): the forward-difference step of its Jacobian in
 # the unit box, and its budget of residual evaluations (each Jacobian costs n + 1 more, in one batch)
@@ -417,11 +408,11 @@ def polish(
     """Refine a run's best point with a small CMA-ES around it (step `sigma` in the unit box).
 
     `budget` (population, generations) defaults to `POLISH_BUDGET`; stops early by `stagnation`
-    (default `Stagnation(patience=POLISH_PATIENCE)`). Keeps the start point if the polish finds nothing
+    (default `Stagnation(patience=15)`). Keeps the start point if the polish finds nothing
     better; the history continues the start's.
     """
     pop_size, generations = POLISH_BUDGET if budget is None else budget
-    stop = stagnation if stagnation is not None else Stagnation(patience=POLISH_PATIENCE)
+    stop = stagnation if stagnation is not None else Stagnation(patience=15)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     x, f, history = minimize_batch(
         problem, _cmaes(np.clip(start.x, 0.0, 1.0), sigma, pop_size, generations), generations,
