@@ -7,10 +7,12 @@ filter on the same time grid before they are compared:
   (``scipy.signal.sosfiltfilt``'s numbers): zero phase, so no lag between the signals; it keeps
   the 1θ_e and 2θ_e fault harmonics (≤ 80 Hz on the FDI chirp) and removes the hysteresis ripple
   (kHz). The one biquad is designed here (`butterworth2`, `biquad_zi`) and run by the numba
-  kernel `kernels.fitness.sosfiltfilt_many`, the same numbers as ``butter``, ``sosfilt_zi`` and
-  ``sosfiltfilt`` to the last bit (tests), because importing ``scipy.signal`` costs 0.9 s
-  (scipy 1.17 loads all of it, ``scipy.stats`` included) on every ``emaphm identify``, whose
-  goal is 2 s in all; the order-8 anti-aliasing filter of `resample` still imports it.
+  kernel `kernels.fitness.sosfiltfilt_many`: the numbers of ``butter`` and ``sosfilt_zi`` to the
+  last bit, those of ``sosfiltfilt`` to the last bit on the machines measured (the tests allow
+  1e-12 for a scipy built with fused multiply-adds). Not scipy's own, because importing
+  ``scipy.signal`` costs 0.9 s (scipy 1.17 loads all of it, ``scipy.stats`` included) on every
+  ``emaphm identify``, whose goal is 2 s in all; the order-8 anti-aliasing filter of `resample`
+  still imports it.
 - **grid**: the LF model's sample grid t_k = k/f_s; a reference trace on another grid is
   interpolated onto it (`Comparison.from_trace`, `resample`), after an anti-aliasing low-pass on
   its own grid when it is sampled faster.
