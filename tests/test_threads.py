@@ -31,10 +31,13 @@ def test_inside_numba_has_the_workers_and_blas_one_thread_restored_after():
 
 
 def test_the_limits_are_restored_after_an_error():
-    before = blas_threads()
-    with pytest.raises(RuntimeError), numba_threads(1):
-        raise RuntimeError("boom")
-    assert blas_threads() == before
+    np.linalg.svd(np.ones((50, 8)))
+    with threadpool_limits(limits=2, user_api="blas"):  # not 1 before, or the test could not fail
+        before = blas_threads()
+        with pytest.raises(RuntimeError), numba_threads(1):
+            assert blas_threads() == [1]
+            raise RuntimeError("boom")
+        assert blas_threads() == before
 
 
 def test_too_many_workers_is_refused_in_one_line():

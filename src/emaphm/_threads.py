@@ -5,7 +5,11 @@ one thread. Its own thread pool otherwise wakes on every call (scipy's least squ
 eigendecomposition) and keeps spinning while numba's pool runs the next kernel: on 2 cores the
 two pools fight, and the least-squares polish took 0.56 s instead of 0.07 s (Table 1 case, the
 same numbers). The matrices here are small (8 columns), so one BLAS thread loses nothing.
-`threadpoolctl` sets and restores the limit.
+`threadpoolctl` sets and restores the limit; it reaches the BLAS libraries loaded when a
+block is entered (numpy's, and scipy's, which `emaphm.identification` loads through
+`scipy.optimize`). The limit is the process's, and threadpoolctl lets one thread at a time
+control it (the others' calls do nothing): where several threads run blocks at once, those
+other than the first may run beside BLAS's own pool, slower.
 """
 
 from __future__ import annotations
@@ -21,12 +25,11 @@ def numba_threads(workers: int | None, *, name: str = "workers") -> Iterator[Non
     """Use `workers` numba threads inside the block (None or 0: all), and one BLAS thread;
     `name` is used in the error."""
     import numba
+    from threadpoolctl import threadpool_limits
 
     available = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
     if workers is not None and not 0 <= workers <= available:
         raise InputError(f"{name} must be 0..{available}, got {workers}")
-    from threadpoolctl import threadpool_limits
-
     previous = numba.get_num_threads()
     numba.set_num_threads(workers or available)
     try:

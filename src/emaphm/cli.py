@@ -409,6 +409,10 @@ def _progress() -> Iterator[Callable[[str, int, int], None]]:
         return
     from rich.progress import Progress
 
+    from .identification.optimizers import import_cmaes
+
+    import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
+
     with Progress(console=err, transient=True) as bar:
         tasks: dict[str, Any] = {}
 

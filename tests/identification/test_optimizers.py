@@ -240,3 +240,19 @@ def test_the_least_squares_polish_survives_residuals_that_are_not_finite():
     bad = OptimizerRun(np.array([0.75, 0.5, *CENTRE[2:]]), 1.0, 3, [1.0])
     kept = least_squares_polish(holes, bad)
     assert np.array_equal(kept.x, bad.x) and kept.f == 1.0 and kept.evaluations == 4
+
+
+def test_import_cmaes_puts_the_blocked_modules_back_when_the_import_fails(monkeypatch):
+    import sys
+    import threading
+
+    from emaphm.identification.optimizers import CMA_UNUSED_IMPORTS, import_cmaes
+
+    for name in ("cma", *CMA_UNUSED_IMPORTS):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    monkeypatch.setitem(sys.modules, "pymoo.algorithms.soo.nonconvex.cmaes", None)  # the import fails
+    monkeypatch.setattr(threading, "active_count", lambda: 1)
+    with pytest.raises(ImportError):
+        import_cmaes()
+    for name in CMA_UNUSED_IMPORTS:
+        assert name not in sys.modules  # not left behind as None: importable again

@@ -86,6 +86,37 @@ def test_lowpass_is_scipys_sosfiltfilt(f_s, shape):
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
 
 
+def test_lowpass_of_awkward_inputs_is_scipys():
+    rng = np.random.default_rng(7)
+    sos = butter(2, CUTOFF_HZ, fs=1e4, output="sos")
+    base = 2.0 + np.cumsum(rng.normal(size=(4, 3, 700)), axis=-1) * 0.05
+    strided = base[::2, :, ::3]  # not contiguous
+    np.testing.assert_allclose(lowpass(strided, 1e4), sosfiltfilt(sos, strided), rtol=1e-12, atol=1e-15)
+    middle = np.ascontiguousarray(np.moveaxis(base, -1, 1))  # (4, 700, 3): filter along axis 1
+    np.testing.assert_allclose(
+        lowpass(middle, 1e4, axis=1), sosfiltfilt(sos, middle, axis=1), rtol=1e-12, atol=1e-15
+    )
+    ints = (base[0, 0] * 100).astype(np.int64)
+    np.testing.assert_allclose(
+        lowpass(ints, 1e4), sosfiltfilt(sos, ints.astype(float)), rtol=1e-12, atol=1e-12
+    )
+    single = base[0, 0].astype(np.float32)
+    np.testing.assert_allclose(
+        lowpass(single, 1e4), sosfiltfilt(sos, single.astype(float)), rtol=1e-12, atol=1e-12
+    )
+    frozen = base[1, 1].copy()
+    frozen.flags.writeable = False
+    np.testing.assert_allclose(lowpass(frozen, 1e4), sosfiltfilt(sos, frozen), rtol=1e-12, atol=1e-15)
+    # a row with a NaN spoils itself only, whether first or second of a pair
+    pair = base[2, :2].copy()
+    pair[0, 350] = np.nan
+    for rows in (pair, pair[::-1]):
+        got = lowpass(rows, 1e4)
+        bad = int(np.isnan(rows[1, 350]))
+        assert np.isnan(got[bad]).all() and np.isfinite(got[1 - bad]).all()
+        np.testing.assert_allclose(got[1 - bad], sosfiltfilt(sos, rows[1 - bad]), rtol=1e-12, atol=1e-15)
+
+
 def test_lowpass_along_another_axis_and_input_untouched():
     rng = np.random.default_rng(3)
     x = rng.normal(size=(600, 3))

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..kernels.fitness import sosfiltfilt_many
+from ..kernels.fitness import sosfiltfilt_many, sosfiltfilt_one
 
 __all__ = [
     "CUTOFF_HZ",
@@ -80,12 +80,16 @@ def biquad_zi(sos: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.linalg.solve(i_minus_a, np.array([b1 - a1 * b0, b2 - a2 * b0]))[None, :]  # type: ignore[no-any-return]
 
 
-@functools.lru_cache(maxsize=16)
 def comparison_filter(
     f_s: float, cutoff: float = CUTOFF_HZ
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
     """The comparison filter for rate `f_s`: (sos, zi, pad), pad = ``sosfiltfilt``'s default edge
-    (9 samples). Read-only arrays (cached)."""
+    (9 samples). Read-only arrays (cached per rate and cutoff)."""
+    return _comparison_filter(float(f_s), float(cutoff))
+
+
+@functools.lru_cache(maxsize=16)
+def _comparison_filter(f_s: float, cutoff: float) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
     sos = butterworth2(cutoff, f_s)
     zi = biquad_zi(sos)
     sos.flags.writeable = False
@@ -102,14 +106,17 @@ def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
 def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = -1) -> NDArray[np.float64]:
     """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`: the numbers of
     ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``."""
-    sos, zi, pad = comparison_filter(float(f_s), float(cutoff))
+    sos, zi, pad = comparison_filter(f_s, cutoff)
     a = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
     n = a.shape[-1]
     if n <= pad:
         raise ValueError(f"the filter needs more than {pad} samples, got {n}")
     rows = np.ascontiguousarray(a.reshape(-1, n))
     out = np.empty_like(rows)
-    sosfiltfilt_many(rows, sos, zi, pad, out)
+    if rows.shape[0] == 1:  # the usual case (a reference, a figure): no parallel launch
+        sosfiltfilt_one(rows[0], sos, zi, pad, out[0])
+    else:
+        sosfiltfilt_many(rows, sos, zi, pad, out)
     return np.moveaxis(out.reshape(a.shape), -1, axis)
 
 

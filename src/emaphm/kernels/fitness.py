@@ -21,7 +21,8 @@ per sample for the LF run itself): each thread filters two rows at once, interle
 two chains overlap (measured 131 µs per row alone, 79 µs per row in pairs, 10001 samples).
 
 The filter (`sos`, `zi`, `pad`) is designed in Python (`signals.comparison_filter`) once per
-identification and passed in. `sosfiltfilt_many` is the same filter alone, for `signals.lowpass`.
+identification and passed in. `sosfiltfilt_many` and `sosfiltfilt_one` are the same filter
+alone, for `signals.lowpass`.
 """
 
 from __future__ import annotations
@@ -174,6 +175,17 @@ def sosfiltfilt_inplace(e, f, pad, sos, zi):  # type: ignore[no-untyped-def]
     yf = f[m - 1]
     for s in range(sos.shape[0]):  # backward, started at zi·(last forward output)
         biquad_pass(e, f, m - 1, -1, -1, sos[s], zi[s, 0] * ye, zi[s, 1] * ye, zi[s, 0] * yf, zi[s, 1] * yf)
+
+
+@jit
+def sosfiltfilt_one(x, sos, zi, pad, out):  # type: ignore[no-untyped-def]
+    """``out = sosfiltfilt(sos, x)`` for one signal x (n > pad), serially: the numbers of
+    `sosfiltfilt_many`'s rows (paired with a zero signal), without a parallel launch."""
+    n = x.shape[0]
+    buf = np.zeros((2, n + 2 * pad))
+    buf[0, pad : pad + n] = x
+    sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+    out[:] = buf[0, pad : pad + n]
 
 
 @jit(parallel=True)
