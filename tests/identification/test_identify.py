@@ -46,9 +46,9 @@ def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, t
     assert np.all(np.delete(err, 6) < tol), err
     pop, gen = small_polish
     # the GA, the polish of its best point and of its runner-up, the final check of the shorts (8),
-    # one more polish if a candidate fits better, and the least-squares polish (a Jacobian of 9
+    # one more polish if a candidate fits better, and the least-squares polish (a Jacobian of 8
     # rows per residual evaluation at most, and the final value)
-    ls = 1 + optimizers.LS_MAX_NFEV * (1 + 9) + 1
+    ls = 1 + optimizers.LS_MAX_NFEV * (1 + 8) + 1
     assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8 + ls
 
 

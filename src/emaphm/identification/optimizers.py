@@ -81,7 +81,7 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
 
 # The least-squares polish (`least_squares_polish`): the forward-difference step of its Jacobian in
-# the unit box, and its budget of residual evaluations (each Jacobian costs n + 1 more, in one batch)
+# the unit box, and its budget of residual evaluations (each Jacobian costs n more, in one batch)
 LS_STEP = 1e-2
 LS_MAX_NFEV = 30
 
@@ -440,7 +440,8 @@ def least_squares_polish(
     ended with the eccentricity at 0.020 against 0.047, at 1.23x the best fitness other seeds
     found, with the fitness falling all along the straight line to their point; this polish went
     there in 84 evaluations. The Jacobian is taken by forward differences of `step` in one batch
-    of n + 1 rows (backward at the upper bound). Keeps the start if the polish does not improve
+    of n rows from the residual of the point itself, which scipy has just evaluated (backward at
+    the upper bound). Keeps the start if the polish does not improve
     on it, or fails. A residual that is not finite is replaced by a large one: a trial point that
     diverges is rejected; a Jacobian probe that diverges spoils its column, and the step it
     proposes then rarely fits better, so the start is kept. The history continues the start's.
@@ -464,16 +465,26 @@ def least_squares_polish(
     def finite(R: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.where(np.isfinite(R), R, big)
 
+    # the point scipy evaluated last and its residual: it evaluates its start once more, and takes
+    # the Jacobian at the point it has just evaluated and accepted
+    last_x, last_r = x0, r0
+
+    def at(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        nonlocal last_x, last_r
+        if not np.array_equal(x, last_x):
+            last_x, last_r = np.array(x, dtype=np.float64), batch(x[None, :])[0]
+        return last_r
+
     def fun(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        # scipy evaluates its start once more: that is r0 again
-        return finite(r0 if np.array_equal(x, x0) else batch(x[None, :])[0])
+        return finite(at(x))
 
     def jac(x: NDArray[np.float64]) -> NDArray[np.float64]:
         h = np.where(x + step <= 1.0, step, -step)
-        X = np.repeat(x[None, :], n + 1, axis=0)
-        X[np.arange(1, n + 1), np.arange(n)] += h
+        base = finite(at(x))
+        X = np.repeat(x[None, :], n, axis=0)
+        X[np.arange(n), np.arange(n)] += h
         R = finite(batch(X))
-        return ((R[1:] - R[0]) / h[:, None]).T  # type: ignore[no-any-return]
+        return ((R - base) / h[:, None]).T  # type: ignore[no-any-return]
 
     try:
         res = least_squares(
