@@ -10,9 +10,11 @@ from emaphm.kernels.monitor import (
     LF_FIELDS,
     N_AUX,
     N_FIELDS,
+    ecc_harmonics,
     loop_error,
     phi_ecc,
     phi_sc,
+    phi_t,
     simulate_lf,
     simulate_lf_many,
     unbalance,
@@ -57,6 +59,74 @@ def test_eccentricity_gives_a_1theta_term_at_its_phase(phi_e):
     assert abs(h1) == pytest.approx(0.3)
     assert np.angle(-h1) == pytest.approx(np.angle(np.exp(1j * phi_e)))  # −0.3·cos(θ + φ_e)
     assert np.mean(y) == pytest.approx(1.0) and abs(harmonic(y, 2)) < 1e-12
+
+
+def twin_torque_per_amp(N, zeta, phi_e):
+    """Σ_x g_x·u_x over THETA: the twin's torque per unit i_q with i_x = i_q·u_x (k_e = 1), from its
+    own coupling g_x = ∂ψ_x/∂θ (`pmsm_abc.couplings`): an independent reference for `phi_t`."""
+    from emaphm.kernels.pmsm_abc import couplings, stator_pack
+    from emaphm.kernels.transforms import phase_directions
+
+    sp = stator_pack(48.0, 0.1, 4.0, (0.5,) * 3, (1e-3,) * 3, N, zeta, phi_e)
+    s, c = np.sin(THETA), np.cos(THETA)
+    g = couplings(s, c, sp)
+    u = phase_directions(s, c)
+    return sum(g_x * u_x for g_x, u_x in zip(g, u, strict=True))
+
+
+@pytest.mark.parametrize(
+    ("N", "zeta", "phi_e"),
+    [
+        ((0.5, 0.53, 0.93), 0.23, 0.5191 * 2 * np.pi),
+        ((1.0, 0.6, 1.0), 0.3, 1.0),
+        ((0.8, 0.95, 0.55), 0.1, 4.0),
+    ],
+)
+def test_per_phase_torque_shape_is_the_twins_torque_per_amp(N, zeta, phi_e):
+    # with k_E = 1 the k_FS part of φ_T is Σ_x N_x·u_x·(u_x + ζ·sin(2θ_e + φ_e − γ_x)), the twin's
+    # torque per unit i_q from its eccentric flux linkage; the paper's φ_SC·φ_ECC is not, with
+    # shorts in some phases and eccentricity together (a 1θ_e term no flux linkage gives)
+    k_FT, k_FS = 0.01, 40.0
+    s, c = np.sin(THETA), np.cos(THETA)
+    f_ecc = phi_ecc(s, c, zeta * np.cos(phi_e), zeta * np.sin(phi_e))
+    twin = twin_torque_per_amp(N, zeta, phi_e)
+    ours = (phi_t(s, c, *N, k_FT, k_FS, f_ecc, ecc_harmonics(zeta, phi_e)) - k_FT * sum(N) * f_ecc) / (
+        k_FT * k_FS
+    )
+    np.testing.assert_allclose(ours, twin, atol=1e-12)
+    paper = (phi_sc(s, c, *N, k_FT, k_FS) * f_ecc - k_FT * sum(N) * f_ecc) / (k_FT * k_FS)
+    assert np.max(np.abs(paper - twin)) > 0.1 * zeta * abs(unbalance(*N))
+    # the twin's torque has a 3θ_e term ∝ ζ·|U| and no 1θ_e term beyond −(ζ/2)·Σ N_x·cos(θ_e + φ_e)
+    assert abs(harmonic(twin, 1) + 0.5 * zeta * sum(N) * np.exp(1j * phi_e)) < 1e-12
+    assert abs(harmonic(ours, 3)) == pytest.approx(0.5 * zeta * unbalance(*N), rel=1e-9)
+
+
+@pytest.mark.parametrize("n", [1.0, 0.6])
+def test_per_phase_torque_shape_is_the_papers_product_for_a_balanced_winding(n):
+    s, c = np.sin(THETA), np.cos(THETA)
+    zeta, phi_e, k_FT, k_FS = 0.25, 2.0, 0.0067, 97.0
+    f_ecc = phi_ecc(s, c, zeta * np.cos(phi_e), zeta * np.sin(phi_e))
+    ours = phi_t(s, c, n, n, n, k_FT, k_FS, f_ecc, ecc_harmonics(zeta, phi_e))
+    np.testing.assert_allclose(ours, phi_sc(s, c, n, n, n, k_FT, k_FS) * f_ecc, rtol=1e-12)
+
+
+def test_monitor_structure_follows_the_monitor_name():
+    # the default monitor takes φ_T from the eccentric flux linkage, the paper's keeps eqs. 1-2
+    K = np.array([[0.1, 0.1, 0.5, 0.45, 0.05, 0.25, 0.5, 0.5]])
+    default, paper = MonitorEma(), MonitorEma(monitor="paper")
+    assert default.rows(K)[0, IDX["ecc_coupling"]] == 1.0
+    assert paper.rows(K)[0, IDX["ecc_coupling"]] == 0.0
+    # the same coefficients under both structures: the shorts and the eccentricity meet, so the
+    # currents differ; a balanced, concentric machine runs the same either way
+    rows = default.rows(np.vstack([K, [0.1, 0.1, 0.0, 0.0, 0.0, 0.0, 0.5, 0.5]]))
+    other = rows.copy()
+    other[:, IDX["ecc_coupling"]] = 0.0
+    _, theta_cmd = default.sample_grid(0.3)
+    a, b = np.empty((2, len(theta_cmd))), np.empty((2, len(theta_cmd)))
+    simulate_lf_many(theta_cmd, rows, a)
+    simulate_lf_many(theta_cmd, other, b)
+    assert np.max(np.abs(a[0] - b[0])) > 1e-3
+    np.testing.assert_allclose(a[1], b[1], atol=1e-9)
 
 
 def test_population_kernel_is_bit_identical_to_single_runs():

@@ -188,10 +188,12 @@ def scenario_nrmse(
     params: EmaParams,
     n_lf: int,
     commands: Mapping[str, Command] = CALIBRATION_COMMANDS,
+    monitor: str = "default",
 ) -> NDArray[np.float64]:
     """NRMSE of the LF model per (coefficient set, scenario): shape (len(coefficients), len(scenarios)).
 
-    The runs of one command are rows of one population-kernel call.
+    The runs of one command are rows of one population-kernel call; `monitor` sets the
+    structure (`models.monitor_rows`).
     """
     n_c = len(coefficients)
     out = np.empty((n_c, len(scenarios)))
@@ -200,7 +202,9 @@ def scenario_nrmse(
         _, theta_cmd = HighFidelityEma(params, commands[command]).sample_grid()
         K = np.array([scenarios[j].faults for j in which])
         n_s = len(which)
-        rows = monitor_rows(np.tile(K, (n_c, 1)), params, [c for c in coefficients for _ in range(n_s)], n_lf)
+        rows = monitor_rows(
+            np.tile(K, (n_c, 1)), params, [c for c in coefficients for _ in range(n_s)], n_lf, monitor
+        )
         currents = np.empty((rows.shape[0], len(theta_cmd)))
         simulate_lf_many(theta_cmd, rows, currents)
         by_case = currents.reshape(n_c, n_s, -1)
@@ -330,9 +334,9 @@ def calibrate(
         return Coefficients(**{**fixed, **{n: float(v) for n, v in zip(fitted, x, strict=True)}})
 
     def objective(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        return scenario_nrmse([coefficients(x) for x in X], fit, fit_refs, params, n_lf, commands).mean(
-            axis=1
-        )
+        return scenario_nrmse(
+            [coefficients(x) for x in X], fit, fit_refs, params, n_lf, commands, monitor
+        ).mean(axis=1)
 
     def on_generation(generation: int, total: int, best: float) -> None:
         if progress:
@@ -351,10 +355,12 @@ def calibrate(
     # a fixed number of generations: no early stop
     x, _, history = minimize_batch(problem, algorithm, generations, seed=seed, on_generation=on_generation)
     best = coefficients(x)
-    fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands)[0]
-    check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands)[0]
-    check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf, commands)[0]
-    start_nrmse = scenario_nrmse([initial], fit + check, fit_refs + check_refs, params, n_lf, commands)[0]
+    fit_nrmse = scenario_nrmse([best], fit, fit_refs, params, n_lf, commands, monitor)[0]
+    check_nrmse = scenario_nrmse([best], check, check_refs, params, n_lf, commands, monitor)[0]
+    check_noisy = scenario_nrmse([best], check, check_refs_noisy, params, n_lf, commands, monitor)[0]
+    start_nrmse = scenario_nrmse(
+        [initial], fit + check, fit_refs + check_refs, params, n_lf, commands, monitor
+    )[0]
 
     def table(scenarios: Sequence[Scenario], values: NDArray[np.float64]) -> list[dict[str, Any]]:
         return [

@@ -10,7 +10,11 @@ the available voltage ±U_max) and the paper's two shape functions of the electr
 
     φ_SC  = k_FT·{N_A[1 + k_FS·sin²(θ_e + π)] + N_B[1 + k_FS·sin²(θ_e + π/3)] + N_C[1 + k_FS·sin²(θ_e − π/3)]}   (eq. 1)
     φ_ECC = 1 − k_E·ζ·cos(θ_e + φ_e)                                                                      (eq. 2)
-    φ_R = φ_SC,   φ_E = φ_T = φ_SC·φ_ECC                                                    (DESIGN §4.3)
+    φ_R = φ_SC,   φ_E = φ_T = φ_SC·φ_ECC                        (DESIGN §4.3; the paper's monitor)
+
+The default monitor takes φ_E = φ_T from the eccentric flux linkage phase by phase (`phi_t`,
+the twin's coupling g_x of `pmsm_abc.couplings` with k_E·ζ for ζ), which equals φ_SC·φ_ECC for a
+balanced winding and differs where shorts and eccentricity meet (monitor-model.md §1).
 
 One simulation is one row of parameters (`LF_FIELDS`), so a whole GA generation is one call of
 `simulate_lf_many` (prange over rows), bit-identical to row-by-row `simulate_lf`.
@@ -39,6 +43,8 @@ LF_FIELDS = (
     "lsb_theta", "fs_theta",
     # equivalent motor and calibration coefficients
     "p", "k_FT", "k_FS", "k_E", "k_t_eq", "k_e_eq", "R_eq", "L_eq", "tau_i", "U_max",
+    # 1: φ_T from the eccentric flux linkage phase by phase (`phi_t`); 0: the paper's φ_SC·φ_ECC
+    "ecc_coupling",
     # current-loop surrogate of the three-phase hysteresis loop's error (calibrated)
     "k_H", "delta_0", "delta_1", "delta_u", "delta_2", "V_H",
     # the loop's current ripple at a breakaway (calibrated; `mechanics.friction_step`) and its
@@ -54,7 +60,7 @@ AUX_COLUMNS = ("theta_u", "theta_m", "omega_m", "theta_e", "i_q_ref", "T_m")
 N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
- LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX,
+ LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX, ECC_COUPLING,
  K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, I_D, N_LF) = range(N_FIELDS)  # fmt: skip
 
 
@@ -74,6 +80,42 @@ def phi_ecc(sin_e, cos_e, kz_cos, kz_sin):  # type: ignore[no-untyped-def]
     kz_cos = k_E·ζ·cos φ_e and kz_sin = k_E·ζ·sin φ_e are constant over a run.
     """
     return 1.0 - (cos_e * kz_cos - sin_e * kz_sin)
+
+
+@jit
+def phi_t(sin_e, cos_e, N_a, N_b, N_c, k_FT, k_FS, f_ecc, e2):  # type: ignore[no-untyped-def]
+    """Torque and back-EMF shape φ_T = φ_E from the eccentric flux linkage, phase by phase:
+
+        φ_T = k_FT·Σ_x N_x·[φ_ECC + k_FS·u_x·(u_x + k_E·ζ·sin(2θ_e + φ_e − γ_x))]
+
+    u_x + ζ·sin(2θ_e + φ_e − γ_x) is the twin's coupling g_x/k_e,x of phase x (`pmsm_abc.couplings`,
+    ∂ψ_x/∂θ of ψ_x ∝ N_x·[1 − ζ·cos(θ_e + φ_e)]·cos(θ_e − γ_x)), and u_x its current direction
+    (i_x = i_q·u_x), so the k_FS part is the twin's torque per unit i_q with ζ → k_E·ζ; the
+    constant part follows φ_ECC as in eq. 1 × eq. 2. With equal N_x this is φ_SC·φ_ECC; with
+    unequal ones it has the twin's 3θ_e term ∝ ζ·Σ_x (1 − N_x)·cos(3θ_e + φ_e − 2γ_x), where
+    φ_SC·φ_ECC has half of it and a 1θ_e term at θ_e − φ_e − 2γ_x that no flux linkage gives.
+
+    e2 = (a_A, a_B, a_C, b_A, b_B, b_C) with a_x = k_E·ζ·cos(φ_e − γ_x), b_x = k_E·ζ·sin(φ_e − γ_x),
+    constant over a run (`ecc_harmonics`): k_E·ζ·sin(2θ_e + φ_e − γ_x) = a_x·sin 2θ_e + b_x·cos 2θ_e.
+    """
+    u_a, u_b, u_c = phase_directions(sin_e, cos_e)
+    s2 = 2.0 * sin_e * cos_e
+    c2 = cos_e * cos_e - sin_e * sin_e
+    return k_FT * (
+        N_a * (f_ecc + k_FS * u_a * (u_a + e2[0] * s2 + e2[3] * c2))
+        + N_b * (f_ecc + k_FS * u_b * (u_b + e2[1] * s2 + e2[4] * c2))
+        + N_c * (f_ecc + k_FS * u_c * (u_c + e2[2] * s2 + e2[5] * c2))
+    )
+
+
+@jit
+def ecc_harmonics(kz, phi_e):  # type: ignore[no-untyped-def]
+    """(a_A, a_B, a_C, b_A, b_B, b_C) of `phi_t` for kz = k_E·ζ: a_x = kz·cos(φ_e − γ_x), b_x = kz·sin(φ_e − γ_x)."""
+    g = 2.0 * math.pi / 3.0  # γ_A = 0, γ_B = 2π/3, γ_C = −2π/3
+    return (
+        kz * math.cos(phi_e), kz * math.cos(phi_e - g), kz * math.cos(phi_e + g),
+        kz * math.sin(phi_e), kz * math.sin(phi_e - g), kz * math.sin(phi_e + g),
+    )  # fmt: skip
 
 
 @jit
@@ -216,6 +258,8 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     )
     kz_cos = prm[K_E] * prm[ZETA] * math.cos(prm[PHI_E])
     kz_sin = prm[K_E] * prm[ZETA] * math.sin(prm[PHI_E])
+    per_phase = prm[ECC_COUPLING] != 0.0
+    e2 = ecc_harmonics(prm[K_E] * prm[ZETA], prm[PHI_E])
     theta_m = 0.0
     omega_m = 0.0
     theta_u = 0.0
@@ -245,6 +289,12 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             cos_e = math.cos(theta_e)
             f_sc = phi_sc(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS])
             f_ecc = phi_ecc(sin_e, cos_e, kz_cos, kz_sin)
+            if per_phase:  # φ_T = φ_E, and the torque constant k_t,eq·φ_T
+                f_t = phi_t(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS], f_ecc, e2)
+                k_t = prm[K_T_EQ] * f_t
+            else:  # the paper's φ_SC·φ_ECC
+                f_t = f_sc * f_ecc
+                k_t = prm[K_T_EQ] * f_sc * f_ecc
             carry = standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, prm[I_D])
             if carry == 0.0:
                 i *= decay_rl  # a zero vector: the current decays through R_eq, L_eq
@@ -254,7 +304,7 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
                     carry * i_q_ref,
                     omega_m,
                     f_sc,
-                    f_sc * f_ecc,
+                    f_t,
                     decay,
                     g,
                     prm[R_EQ],
@@ -266,7 +316,6 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
             i_m = loop_error(
                 i, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
             )  # fmt: skip
-            k_t = prm[K_T_EQ] * f_sc * f_ecc  # k_t,eq·φ_T
             T_m = k_t * i_m
             # the hysteresis loop's ripple about i_m, which this step averages away, breaks a stuck
             # motor away at its peak: T_ripple = k_t,eq·φ_T·i_R (monitor-model.md §1)

@@ -42,11 +42,17 @@ def resolve_calibration(
 
 
 def monitor_rows(
-    K: NDArray[np.float64], params: EmaParams, coefficients: Sequence[Coefficients], n_lf: int
+    K: NDArray[np.float64],
+    params: EmaParams,
+    coefficients: Sequence[Coefficients],
+    n_lf: int,
+    monitor: str = "default",
 ) -> NDArray[np.float64]:
     """LF parameter rows (layout `kernels.monitor.LF_FIELDS`) for fault rows K (validated, (m, 8)).
 
     `coefficients` holds one `Coefficients` for all rows or one per row (calibration varies them).
+    `monitor` sets the structure: "default" takes φ_T = φ_E from the eccentric flux linkage phase
+    by phase (`kernels.monitor.phi_t`), "paper" the paper's φ_SC·φ_ECC (eqs. 1–2).
     """
     m = K.shape[0]
     if len(coefficients) not in (1, m):
@@ -62,6 +68,7 @@ def monitor_rows(
         # DESIGN §4.2: the equivalent R and L are the phase values; they matter only near the
         # voltage limit, the amplitude-invariant phase-voltage limit of the inverter V_dc/√3
         "R_eq": mot.R_s, "L_eq": mot.L_s, "U_max": params.inverter.V_dc / math.sqrt(3.0), "n_lf": n_lf,
+        "ecc_coupling": 1.0 if check_monitor(monitor) == "default" else 0.0,
     }  # fmt: skip
     for name, value in fixed.items():
         rows[:, IDX[name]] = value
@@ -127,7 +134,7 @@ class MonitorEma(_EmaModel):
     def rows(self, K: ArrayLike) -> NDArray[np.float64]:
         """Validated LF parameter rows for the fault rows K."""
         cal = self.calibration
-        return monitor_rows(as_fault_matrix(K), self.params, [cal.coefficients], cal.n_lf)
+        return monitor_rows(as_fault_matrix(K), self.params, [cal.coefficients], cal.n_lf, cal.monitor)
 
     def simulate_many(
         self, K: ArrayLike, *, duration: float | None = None, check: bool = True
