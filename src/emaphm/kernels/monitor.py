@@ -99,12 +99,12 @@ def phi_t(sin_e, cos_e, N_a, N_b, N_c, k_FT, k_FS, f_ecc, e2):  # type: ignore[n
     constant over a run (`ecc_harmonics`): k_E·ζ·sin(2θ_e + φ_e − γ_x) = a_x·sin 2θ_e + b_x·cos 2θ_e.
     """
     u_a, u_b, u_c = phase_directions(sin_e, cos_e)
-    s2 = 2.0 * sin_e * cos_e
-    c2 = cos_e * cos_e - sin_e * sin_e
+    sin_2e = 2.0 * sin_e * cos_e
+    cos_2e = cos_e * cos_e - sin_e * sin_e
     return k_FT * (
-        N_a * (f_ecc + k_FS * u_a * (u_a + e2[0] * s2 + e2[3] * c2))
-        + N_b * (f_ecc + k_FS * u_b * (u_b + e2[1] * s2 + e2[4] * c2))
-        + N_c * (f_ecc + k_FS * u_c * (u_c + e2[2] * s2 + e2[5] * c2))
+        N_a * (f_ecc + k_FS * u_a * (u_a + e2[0] * sin_2e + e2[3] * cos_2e))
+        + N_b * (f_ecc + k_FS * u_b * (u_b + e2[1] * sin_2e + e2[4] * cos_2e))
+        + N_c * (f_ecc + k_FS * u_c * (u_c + e2[2] * sin_2e + e2[5] * cos_2e))
     )
 
 
