@@ -10,7 +10,6 @@ from emaphm.kernels.monitor import (
     LF_FIELDS,
     N_AUX,
     N_FIELDS,
-    ecc_harmonics,
     loop_error,
     phi_ecc,
     phi_sc,
@@ -20,6 +19,7 @@ from emaphm.kernels.monitor import (
     unbalance,
     unbalance_2,
 )
+from emaphm.kernels.pmsm_abc import ecc_harmonics
 
 THETA = np.linspace(0, 2 * np.pi, 720, endpoint=False)
 

@@ -30,6 +30,7 @@ from numba import prange
 from ._jit import jit
 from .controller import ControllerPack, pid_step
 from .mechanics import MechanicsPack, mechanics_step
+from .pmsm_abc import ecc_harmonics
 from .sensors import quantise
 from .transforms import phase_directions
 
@@ -96,7 +97,8 @@ def phi_t(sin_e, cos_e, N_a, N_b, N_c, k_FT, k_FS, f_ecc, e2):  # type: ignore[n
     φ_SC·φ_ECC has half of it and a 1θ_e term at θ_e − φ_e − 2γ_x that no flux linkage gives.
 
     e2 = (a_A, a_B, a_C, b_A, b_B, b_C) with a_x = k_E·ζ·cos(φ_e − γ_x), b_x = k_E·ζ·sin(φ_e − γ_x),
-    constant over a run (`ecc_harmonics`): k_E·ζ·sin(2θ_e + φ_e − γ_x) = a_x·sin 2θ_e + b_x·cos 2θ_e.
+    constant over a run (`pmsm_abc.ecc_harmonics` of k_E·ζ, the twin's own of ζ):
+    k_E·ζ·sin(2θ_e + φ_e − γ_x) = a_x·sin 2θ_e + b_x·cos 2θ_e.
     """
     u_a, u_b, u_c = phase_directions(sin_e, cos_e)
     sin_2e = 2.0 * sin_e * cos_e
@@ -106,16 +108,6 @@ def phi_t(sin_e, cos_e, N_a, N_b, N_c, k_FT, k_FS, f_ecc, e2):  # type: ignore[n
         + N_b * (f_ecc + k_FS * u_b * (u_b + e2[1] * sin_2e + e2[4] * cos_2e))
         + N_c * (f_ecc + k_FS * u_c * (u_c + e2[2] * sin_2e + e2[5] * cos_2e))
     )
-
-
-@jit
-def ecc_harmonics(kz, phi_e):  # type: ignore[no-untyped-def]
-    """(a_A, a_B, a_C, b_A, b_B, b_C) of `phi_t` for kz = k_E·ζ: a_x = kz·cos(φ_e − γ_x), b_x = kz·sin(φ_e − γ_x)."""
-    g = 2.0 * math.pi / 3.0  # γ_A = 0, γ_B = 2π/3, γ_C = −2π/3
-    return (
-        kz * math.cos(phi_e), kz * math.cos(phi_e - g), kz * math.cos(phi_e + g),
-        kz * math.sin(phi_e), kz * math.sin(phi_e - g), kz * math.sin(phi_e + g),
-    )  # fmt: skip
 
 
 @jit

@@ -86,6 +86,17 @@ class StatorPack(NamedTuple):
     ecc2_cos_c: float
 
 
+@jit
+def ecc_harmonics(zeta, phi_e):  # type: ignore[no-untyped-def]
+    """(a_a, a_b, a_c, b_a, b_b, b_c) with a_x = ζ·cos(φ_e − γ_x), b_x = ζ·sin(φ_e − γ_x): the 2θ_e
+    harmonic of the eccentric coupling, ζ·sin(2θ_e + φ_e − γ_x) = a_x·sin 2θ_e + b_x·cos 2θ_e
+    (the `StatorPack` fields ecc2_sin_x, ecc2_cos_x; the LF monitor's `phi_t` with k_E·ζ)."""
+    return (
+        zeta * math.cos(phi_e - GAMMA[0]), zeta * math.cos(phi_e - GAMMA[1]), zeta * math.cos(phi_e - GAMMA[2]),
+        zeta * math.sin(phi_e - GAMMA[0]), zeta * math.sin(phi_e - GAMMA[1]), zeta * math.sin(phi_e - GAMMA[2]),
+    )  # fmt: skip
+
+
 def stator_pack(V_dc, h, p, R, L, k_e, zeta, phi_e):  # type: ignore[no-untyped-def]
     """StatorPack from per-phase triples R, L, k_e, with the derived fields filled in."""
     inv_L = [1.0 / x for x in L]
@@ -93,8 +104,7 @@ def stator_pack(V_dc, h, p, R, L, k_e, zeta, phi_e):  # type: ignore[no-untyped-
     return StatorPack(
         float(V_dc), float(h), float(p), *map(float, R), *map(float, L), *map(float, k_e),
         zeta, phi_e, *inv_L, 1.0 / sum(inv_L),
-        zeta * math.cos(phi_e), zeta * math.sin(phi_e),
-        *(zeta * math.cos(phi_e - g) for g in GAMMA), *(zeta * math.sin(phi_e - g) for g in GAMMA),
+        zeta * math.cos(phi_e), zeta * math.sin(phi_e), *ecc_harmonics(zeta, phi_e),
     )  # fmt: skip
 
 
