@@ -1,7 +1,7 @@
 """Where in time the monitor at the true faults errs, against the HF twin (issue 8, item 5).
 
     python benchmarks/monitor_error_at_truth.py [--command chirp-2s] [--cases 12] [--window 0.25]
-                                                [--case-seed 2611] [--only 0,12] [--floor]
+                                                [--case-seed 2611] [--only 0,12] [--floor] [--angle]
     python benchmarks/monitor_error_at_truth.py --by-frequency
     python benchmarks/monitor_error_at_truth.py --command steps --cases 20 --rest-share
 
@@ -12,7 +12,10 @@ the RMS of the filtered HF current (mA, over the whole window), and the share of
 the window, over the samples the identification compares (`FaultIdentifier.prepare`: holds at
 rest, parks and motion above the band left out); at the end of each line eq. 3 at the truth in
 all [1e-3 A²], with its sum, median and max over the cases. --floor adds the twin's own chaotic
-floor: the NRMSE of the HF current against the HF with friction k1 + 1e-5.
+floor: the NRMSE of the HF current against the HF with friction k1 + 1e-5. --angle adds to each
+window the largest gap between the twin's and the monitor's motor (|Δθ_e|, electrical rad) and
+between their surfaces, in the same unit (p·τ·|Δθ_u|): a motor gap far above the surface's is
+the motor's angle inside the backlash, which the position sensor does not see (monitor-model.md §4).
 
 --rest-share prints per case, instead of the windows, eq. 3 at the true faults over the samples
 compared without the rests whose measured current is below the monitor's ring edge
@@ -56,6 +59,7 @@ def main() -> None:
     parser.add_argument("--window", type=float, default=0.25, help="window length [s]")
     parser.add_argument("--only", default=None, help="comma-separated case numbers")
     parser.add_argument("--floor", action="store_true", help="also HF against HF with k1 + 1e-5")
+    parser.add_argument("--angle", action="store_true", help="also the motors' and surfaces' gaps")
     parser.add_argument(
         "--rest-share",
         action="store_true",
@@ -77,6 +81,7 @@ def main() -> None:
     edges = np.arange(0.0, command.duration + 1e-9, args.window)
     print(
         f"command {args.command}, windows of {args.window:g} s: error / HF RMS [mA] and share of eq. 3 at the truth"
+        + (", then the motors' / surfaces' largest gap [electrical rad]" if args.angle else "")
     )
     totals: list = []  # eq. 3 per case, or (eq. 3, share) with --rest-share
     for j, k in enumerate(cases):
@@ -84,7 +89,12 @@ def main() -> None:
             continue
         trace = hf.simulate(k, noise=False)
         whole = Comparison.from_signal(trace.t, trace.i_q, hf.params.controller.f_s)
-        lf = whole.filtered(monitor.simulate(k).i_q)
+        lf_trace = monitor.simulate(k)
+        lf = whole.filtered(lf_trace.i_q)
+        # electrical rad per rad of the surface
+        per_rad = hf.params.motor.p * hf.params.transmission.tau
+        gap_e = np.abs(trace.theta_e - lf_trace.theta_e)
+        gap_u = per_rad * np.abs(trace.theta_u_true - lf_trace.theta_u_true)
         ident = FaultIdentifier(monitor=monitor).prepare(
             trace.t, trace.i_q, SampledCommand(trace.t, trace.theta_cmd), trace.theta_u
         )
@@ -104,6 +114,9 @@ def main() -> None:
             ref = 1e3 * np.sqrt(np.mean(whole.reference[s] ** 2))
             share = cost[(tc >= a) & (tc < b)].sum() / cost.sum()
             cells.append(f"{err:5.1f}/{ref:5.1f} {share:4.2f}")
+            if args.angle:
+                w = (trace.t >= a) & (trace.t < b)
+                cells[-1] += f" {gap_e[w].max():4.2f}/{gap_u[w].max():4.2f}"
         totals.append(float(cost.sum()))
         line = f"{j:>3} " + " | ".join(cells) + f" | eq. 3 {1e3 * totals[-1]:7.2f}"
         if args.floor:
