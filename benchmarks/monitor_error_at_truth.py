@@ -79,6 +79,7 @@ def main() -> None:
     cases = random_faults(args.cases, args.case_seed)
     only = None if args.only is None else {int(j) for j in args.only.split(",")}
     edges = np.arange(0.0, command.duration + 1e-9, args.window)
+    per_rad = hf.params.motor.p * hf.params.transmission.tau  # electrical rad per rad of the surface
     print(
         f"command {args.command}, windows of {args.window:g} s: error / HF RMS [mA] and share of eq. 3 at the truth"
         + (", then the motors' / surfaces' largest gap [electrical rad]" if args.angle else "")
@@ -91,10 +92,9 @@ def main() -> None:
         whole = Comparison.from_signal(trace.t, trace.i_q, hf.params.controller.f_s)
         lf_trace = monitor.simulate(k)
         lf = whole.filtered(lf_trace.i_q)
-        # electrical rad per rad of the surface
-        per_rad = hf.params.motor.p * hf.params.transmission.tau
-        gap_e = np.abs(trace.theta_e - lf_trace.theta_e)
-        gap_u = per_rad * np.abs(trace.theta_u_true - lf_trace.theta_u_true)
+        if args.angle:
+            gap_e = np.abs(trace.theta_e - lf_trace.theta_e)
+            gap_u = per_rad * np.abs(trace.theta_u_true - lf_trace.theta_u_true)
         ident = FaultIdentifier(monitor=monitor).prepare(
             trace.t, trace.i_q, SampledCommand(trace.t, trace.theta_cmd), trace.theta_u
         )

@@ -19,7 +19,8 @@ from emaphm.kernels.monitor import (
     unbalance,
     unbalance_2,
 )
-from emaphm.kernels.pmsm_abc import ecc_harmonics
+from emaphm.kernels.pmsm_abc import couplings, ecc_harmonics, stator_pack
+from emaphm.kernels.transforms import phase_directions
 
 THETA = np.linspace(0, 2 * np.pi, 720, endpoint=False)
 
@@ -64,9 +65,6 @@ def test_eccentricity_gives_a_1theta_term_at_its_phase(phi_e):
 def twin_torque_per_amp(N, zeta, phi_e):
     """Σ_x g_x·u_x over THETA: the twin's torque per unit i_q with i_x = i_q·u_x (k_e = 1), from its
     own coupling g_x = ∂ψ_x/∂θ (`pmsm_abc.couplings`): an independent reference for `phi_t`."""
-    from emaphm.kernels.pmsm_abc import couplings, stator_pack
-    from emaphm.kernels.transforms import phase_directions
-
     sp = stator_pack(48.0, 0.1, 4.0, (0.5,) * 3, (1e-3,) * 3, N, zeta, phi_e)
     s, c = np.sin(THETA), np.cos(THETA)
     g = couplings(s, c, sp)
