@@ -47,7 +47,7 @@ from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS
-from emaphm.identification.identify import FaultIdentifier
+from emaphm.identification.identify import SECOND_SEARCH_NRMSE, FaultIdentifier
 from emaphm.identification.signals import nrmse as nrmse_of
 from emaphm.models import HighFidelityEma, MonitorEma
 
@@ -116,8 +116,9 @@ def main() -> None:
     monitor = MonitorEma(params, command, args.calibration, monitor=args.monitor)
     hf = HighFidelityEma(params, command)
     errs, walls, wrong, bias_runs, nrmses, nrmses_cmp = [], [], 0, 0, [], []
+    fits, second_runs, second_taken = [], 0, 0
     print(
-        f"{'case':>4} {'NRMSE':>6} {'cmp':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'wall':>5}  shorts"
+        f"{'case':>4} {'NRMSE':>6} {'cmp':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'fit':>6} {'wall':>5}  shorts"
     )
     for j, k in enumerate(cases):
         clean = hf.simulate(k, noise=False)
@@ -161,10 +162,19 @@ def main() -> None:
             f_best = min([run.fitness, *others, earlier.get((j, s), np.inf)])
             f_true = float(fitness_at(trace, k[None, :], monitor)[0])
             is_wrong = run.fitness > 1.2 * f_best
+            fits.append(run.fit_nrmse)
+            second = run.settings["second_search_run"]
+            second_runs += second is not None
+            second_taken += second is not None and second["taken"]
+            mark = (
+                ""
+                if second is None
+                else f"  2nd search {'taken' if second['taken'] else 'not taken'} (first fit {100 * second['first_fit_nrmse']:.2f}%)"
+            )
             wrong += is_wrong
             bias_runs += f_true > run.fitness
             print(f"{j:>4} {100 * nrmse:>5.2f}% {100 * nrmses_cmp[-1]:>5.2f}% {s:>4} {err:>6.2f} {run.fitness:>8.4f} {f_best:>8.4f} {f_true:>8.4f} "
-                  f"{walls[-1]:>5.1f}  {k[2]:.2f} {k[3]:.2f} {k[4]:.2f}" + ("  WRONG BASIN" if is_wrong else ""),
+                  f"{100 * run.fit_nrmse:>5.2f}% {walls[-1]:>5.1f}  {k[2]:.2f} {k[3]:.2f} {k[4]:.2f}" + ("  WRONG BASIN" if is_wrong else "") + mark,
                   flush=True)  # fmt: skip
     n = len(errs)
     print()
@@ -176,6 +186,9 @@ def main() -> None:
           f"max {max(errs):.2f}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
     print(f"wrong basins (final fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
           f"runs whose estimate fits better than the truth (model bias): {bias_runs} of {n}")  # fmt: skip
+    print(f"fit NRMSE over the compared samples: median {100 * statistics.median(fits):.2f} %, "
+          f"p90 {100 * float(np.percentile(fits, 90)):.2f} %, max {100 * max(fits):.2f} %; "
+          f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[args.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
     print(f"wall time per identification: median {statistics.median(walls):.1f} s, max {max(walls):.1f} s")
 
 

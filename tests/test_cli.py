@@ -275,6 +275,29 @@ def test_identify_from_a_reference_trace(tmp_path, capsys):
     assert code == 0 and data["truth"] is None and data["percent_error"] is None
 
 
+def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, monkeypatch):
+    import json
+
+    from emaphm.identification import identify as identify_module
+    from emaphm.identification import optimizers
+
+    # a trigger every fit exceeds, a tiny polish: the second search runs, and the output says so
+    monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.0)
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--uncertainty", "none", "--pop-size", "8",
+            "--generations", "2"]  # fmt: skip
+    code, stdout, _ = run_cli(args, capsys)
+    assert code == 0 and "second search: the first fit (" in stdout
+    code, stdout, _ = run_cli([*args, "--json"], capsys)
+    record = json.loads(stdout)["settings"]["second_search_run"]
+    assert code == 0 and record is not None and record["first_fit_nrmse"] > 0
+    code, stdout, _ = run_cli([*args, "--json", "--no-second-search"], capsys)
+    data = json.loads(stdout)
+    assert data["settings"]["second_search"] is False and data["settings"]["second_search_run"] is None
+    code, stdout, _ = run_cli([*args, "--no-second-search"], capsys)
+    assert "second search" not in stdout
+
+
 def _write_bad_traces(d):
     (d / "corrupt.h5").write_bytes(b"garbage")
     (d / "nan.csv").write_text(

@@ -309,3 +309,21 @@ def test_a_campaign_sets_the_error_corner_as_identify_does(tmp_path):
         (job,) = load_campaign(tmp_path / "c.toml").jobs()
         kwargs = identify_kwargs(job.to_dict())
         assert kwargs["error_corner_hz"] == passed and "error_corner" not in kwargs
+
+
+def test_a_campaign_can_turn_the_second_search_off_as_identify_does(tmp_path):
+    """[identify] second_search reaches `emaphm.identify`; not a bool: refused in one line."""
+    from emaphm.campaign.jobs import identify_kwargs
+
+    for given, passed in (("false", False), ("true", True)):
+        (tmp_path / "c.toml").write_text(
+            f'[campaign]\nname = "x"\n[identify]\nsecond_search = {given}\n'
+            '[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n'
+        )
+        (job,) = load_campaign(tmp_path / "c.toml").jobs()
+        assert identify_kwargs(job.to_dict())["second_search"] is passed
+    (tmp_path / "c.toml").write_text(
+        '[campaign]\nname = "x"\n[identify]\nsecond_search = "no"\n[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n'
+    )
+    with pytest.raises(InputError, match="second_search"):
+        load_campaign(tmp_path / "c.toml")

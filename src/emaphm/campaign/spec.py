@@ -6,7 +6,7 @@ name  = "fleet-a"
 seeds = [1]                        # each measurement is identified once per seed (default [1])
 
 [identify]                         # settings of every identification (all optional):
-optimizer = "ga"                   # optimizer, pop_size, generations, polish, uncertainty,
+optimizer = "ga"                   # optimizer, pop_size, generations, polish, second_search, uncertainty,
 uncertainty = "laplace"            # monitor, calibration, uq_calibration, params
 
 [[actuator]]                       # one measurement on the HF twin (noise on)
@@ -88,7 +88,7 @@ TOP_KEYS = {"campaign", "identify", "actuator", "fleet"}
 CAMPAIGN_KEYS = {"name", "seeds", "description"}
 # identify() settings a campaign may set, with their checks; file paths resolved to the spec's folder
 IDENTIFY_KEYS = {
-    "optimizer": str, "pop_size": int, "generations": int, "polish": bool, "uncertainty": str,
+    "optimizer": str, "pop_size": int, "generations": int, "polish": bool, "second_search": bool, "uncertainty": str,
     "monitor": str, "calibration": Path, "uq_calibration": Path, "params": Path,
     "error_corner": float,  # "auto", "off" or Hz, as identify --error-corner
 }  # fmt: skip

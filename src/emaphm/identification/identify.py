@@ -66,12 +66,14 @@ __all__ = [
     "MIN_COMPARED",
     "MIN_SAMPLES",
     "MIN_SPAN",
+    "SECOND_SEARCH_NRMSE",
     "FaultIdentifier",
     "IdentificationResult",
     "identify",
     "polish_two",
     "runner_up",
     "search_to_faults",
+    "second_seed",
 ]
 
 MIN_SAMPLES = 200  # a reference shorter than this (20 ms at 10 kHz) cannot show the faults
@@ -96,6 +98,32 @@ FIT_NRMSE_LIMIT = 0.5
 # fit several times worse points at the recording (a cut segment, a command the monitor was not
 # calibrated on, another actuator) more than at the faults
 FIT_NRMSE_WARN = 0.12
+# a second, independent search runs when the first one's fit is poorer than this (NRMSE over the
+# compared samples), per monitor, and the better of the two is kept (`FaultIdentifier.second_search`).
+# The default monitor's usual fits, noise on (bench_multifault, seed 2611): the 1 s chirp 1.74 /
+# 2.17 / 2.79 % (median / p90 / max, 80 runs), the steps 0.70 / 0.81 / 0.82 % (20 runs); a wrong
+# basin seen on the steps fitted to 4.9 % and was still "fits" under `FIT_NRMSE_WARN`. The
+# paper's monitor fits the chirp to 2.3-3.5 % (its first 8 cases, seed 1; docs/identification.md)
+SECOND_SEARCH_NRMSE: dict[str, float] = {"default": 0.03, "paper": 0.05}
+
+
+def second_seed(seed: int) -> int:
+    """The optimiser seed of the second search (`SECOND_SEARCH_NRMSE`), drawn from the first's."""
+    return int(np.random.SeedSequence(seed).generate_state(1)[0])
+
+
+@dataclass
+class _Search:
+    """One whole search of `FaultIdentifier` and what it did (`FaultIdentifier._search`)."""
+
+    run: OptimizerRun
+    fit_nrmse: float
+    fitted: NDArray[np.float64] | None
+    runner_up_won: bool | None
+    permutation: list[int] | None
+    short_move: str | None
+    eccentricity_move: str | None
+    least_squares_gain: float | None
 
 
 def explains(fit_nrmse: float | None) -> bool:
@@ -199,6 +227,11 @@ class FaultIdentifier:
         over `patience` generations.
     local_polish : bool
         Refine the best point with a small CMA-ES (≤ 1600 more evaluations).
+    second_search : bool
+        With `local_polish`: when the fit's NRMSE over the compared samples exceeds
+        `SECOND_SEARCH_NRMSE` of the monitor (and the fit still explains the measurement, `FIT_NRMSE_LIMIT`), run a
+        whole second search from `second_seed(seed)` and keep the better (about twice the time
+        for those runs); `second_search_` records it (None: not run).
     slope_unit : {"s", "ms"}
         Time unit of the slope in the eq. (3) weights.
     error_corner_hz : float, None or "auto"
@@ -222,6 +255,7 @@ class FaultIdentifier:
         patience: int = 25,
         rtol: float = 1e-3,
         local_polish: bool = True,
+        second_search: bool = True,
         slope_unit: str = "s",
         error_corner_hz: float | str | None = "auto",
         monitor: MonitorEma | None = None,
@@ -234,6 +268,7 @@ class FaultIdentifier:
         self.patience = patience
         self.rtol = rtol
         self.local_polish = local_polish
+        self.second_search = second_search
         self.slope_unit = slope_unit
         self.error_corner_hz = error_corner_hz
         self.monitor = monitor
@@ -355,36 +390,70 @@ class FaultIdentifier:
             return fitness.of_monitor(monitor, search_to_faults(X), duration=duration)
 
         start = time.perf_counter()
-        self.runner_up_won_: bool | None = None  # None: no polish
+        first = self._search(evaluate, seed)
+        kept = first
+        # a second, independent search when the first one's fit is clearly poorer than the monitor's
+        # usual (`SECOND_SEARCH_NRMSE`) while still a fit (`FIT_NRMSE_LIMIT`); the better is kept
+        self.second_search_: dict[str, Any] | None = None
+        trigger = SECOND_SEARCH_NRMSE[monitor.monitor]
+        if self.local_polish and self.second_search and trigger < first.fit_nrmse <= FIT_NRMSE_LIMIT:
+            second = self._search(evaluate, second_seed(seed))
+            won = second.run.f < first.run.f
+            kept = second if won else first
+            self.second_search_ = {
+                "trigger": trigger,
+                "seed": second_seed(seed),
+                "first_fit_nrmse": round(first.fit_nrmse, 6),
+                "second_fit_nrmse": round(second.fit_nrmse, 6),
+                "fitness_ratio": round(second.run.f / first.run.f, 6) if first.run.f > 0 else None,
+                "taken": won,
+            }
+            kept.run = OptimizerRun(
+                kept.run.x, kept.run.f, first.run.evaluations + second.run.evaluations, kept.run.history
+            )
+        self.wall_time_ = time.perf_counter() - start
+        run = kept.run
+        # what the kept search did (`_Search`), for the record
+        self.runner_up_won_, self.permutation_ = kept.runner_up_won, kept.permutation
+        self.short_move_, self.eccentricity_move_ = kept.short_move, kept.eccentricity_move
+        self.least_squares_gain_ = kept.least_squares_gain
+        self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
+        self.fitness_ = run.f
+        self.run_ = run
+        # how well the best LF current explains the compared samples (both filtered), for the verdict
+        self.fit_nrmse_, self.fitted_ = kept.fit_nrmse, kept.fitted
+        return self
+
+    def _search(self, evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]], seed: int) -> _Search:
+        """One whole search from `seed`: the optimiser, the polish of its best point and runner-up,
+        the final checks of the shorts' phases and of a trapped eccentricity, the least-squares
+        polish; then the fit's NRMSE over the compared samples (inf when its run diverges)."""
+        runner_up_won: bool | None = None  # None: no polish
         run: OptimizerRun = run_optimizer(
             self.optimizer, evaluate, pop_size=self.pop_size, generations=self.generations, seed=seed,
             stagnation=Stagnation(self.patience, self.rtol), on_generation=self.on_generation,
         )  # fmt: skip
         if self.local_polish:
-            run, self.runner_up_won_ = polish_two(evaluate, run, seed=seed, on_generation=self.on_generation)
-        run, self.permutation_, self.short_move_ = try_short_permutations(
+            run, runner_up_won = polish_two(evaluate, run, seed=seed, on_generation=self.on_generation)
+        run, permutation, short_move = try_short_permutations(
             evaluate, run, seed=seed, polish_it=self.local_polish
         )
-        run, self.eccentricity_move_ = try_eccentricity_directions(
+        run, eccentricity_move = try_eccentricity_directions(
             evaluate, run, seed=seed, polish_it=self.local_polish
         )
-        self.least_squares_gain_: float | None = None  # None: no polish
+        least_squares_gain: float | None = None  # None: no polish
         if self.local_polish:
-            run, self.least_squares_gain_ = self._least_squares(evaluate, run)
-        self.wall_time_ = time.perf_counter() - start
-        self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
-        self.fitness_ = run.f
-        self.run_ = run
-        # how well the best LF current explains the compared samples (both filtered), for the verdict
-        self.fitted_: NDArray[np.float64] | None = None
+            run, least_squares_gain = self._least_squares(evaluate, run)
+        faults = as_fault_vector(search_to_faults(run.x[None, :])[0])
+        fitted: NDArray[np.float64] | None = None
         try:
-            best = self.reference_.filtered(monitor.simulate(self.faults_, duration=duration).i_q)
+            fitted = self.reference_.filtered(self.monitor_.simulate(faults, duration=self.duration_).i_q)
             keep = self.mask_ > 0
-            self.fit_nrmse_ = float(nrmse(self.reference_.reference[keep], best[keep]))
-            self.fitted_ = best
+            fit_nrmse = float(nrmse(self.reference_.reference[keep], fitted[keep]))
         except SimulationError:
-            self.fit_nrmse_ = float("inf")
-        return self
+            fit_nrmse = float("inf")
+        return _Search(run, fit_nrmse, fitted, runner_up_won, permutation, short_move, eccentricity_move,
+                       least_squares_gain)  # fmt: skip
 
     def residuals(self) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
         """Eq. (3)'s residual vectors r = √w·(I_ref − I_LF) over the compared samples for rows X
@@ -652,6 +721,7 @@ def identify(
     pop_size: int | None = None,
     generations: int | None = None,
     local_polish: bool = True,
+    second_search: bool = True,
     slope_unit: str = "s",
     error_corner_hz: float | str | None = "auto",
     on_generation: OnGeneration | None = None,
@@ -672,6 +742,10 @@ def identify(
     packaged one by default); one made for other actuator parameters raises `InputError`.
     `monitor` picks the monitor model: "default", or "paper" (the paper's single-phase model,
     eqs. 1–2 alone, to reproduce the paper); None: the calibration's (`MonitorEma`).
+
+    `second_search` (with `local_polish`) searches again from another seed when the first fit is
+    poorer than the monitor's usual (`SECOND_SEARCH_NRMSE`) and keeps the better;
+    ``settings["second_search_run"]`` records it (`FaultIdentifier`).
 
     `error_corner_hz` weights eq. (3) by the command's local frequency (`FaultIdentifier`): "auto"
     (default) as the monitor was measured to need, None for the paper's eq. 3 unweighted.
@@ -755,7 +829,7 @@ def identify(
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
-        slope_unit=slope_unit, error_corner_hz=error_corner_hz, monitor=monitor_model, on_generation=on_generation,
+        second_search=second_search, slope_unit=slope_unit, error_corner_hz=error_corner_hz, monitor=monitor_model, on_generation=on_generation,
     )  # fmt: skip
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
@@ -853,6 +927,11 @@ def identify(
         # the fitness ratio the last, least-squares polish gave (1.0: its point rejected, the
         # previous one kept; None: no polish)
         "least_squares_gain": ident.least_squares_gain_,
+        "second_search": second_search,
+        # the second search a poor first fit started (SECOND_SEARCH_NRMSE): the fit NRMSE that
+        # starts it, its seed, both fits' NRMSE, its fitness over the first's and whether it was
+        # taken; None: not run
+        "second_search_run": ident.second_search_,
         # the fraction of samples the fitness compares (long holds of the command are left out)
         "samples_compared": round(ident.compared_, 4),
         # the fraction whose command is faster than the band the monitor was fitted on (left out)
