@@ -288,8 +288,8 @@ def _print_identification(data: dict[str, Any]) -> None:
         out.print(f"%err {data['percent_error']:.2f}")
     if data["fit_nrmse"] is not None:
         out.print(
-            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 2-6 %; "
-            "above 50 %: does not fit)"
+            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.5-4 %; "
+            "above 6 % a warning, above 50 %: does not fit)"
         )
     second = data["settings"].get("second_search_run")
     if second is not None:
