@@ -94,7 +94,7 @@ MIN_SPAN = MIN_DURATION  # 0.2 s, the reader's shortest clean segment too (measu
 # command in degrees 646 % (tests/identification/test_verdict.py)
 FIT_NRMSE_LIMIT = 0.5
 # above this a fit is reported with a warning: the twin's actuators fit the default monitor to
-# 0.5-3.9 % over the compared samples (bench_multifault, noise on, 440 runs on the chirp, the chirp
+# 0.4-3.9 % over the compared samples (bench_multifault, noise on, 480 runs on the chirp, the chirp
 # to 2 s, the chirp with a hold and the steps; at the truth, noise off, 7 of 1000 chirp cases
 # exceed 4 % and one 7.6 %), so a fit several times the usual points at the recording (a sensor
 # gain: the Table 1 case with its current 1.2x fits to 10.1 %, 1.1x to 4.9 %; a cut segment, a
