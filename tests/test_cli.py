@@ -287,15 +287,31 @@ def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, mon
     args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--uncertainty", "none", "--pop-size", "8",
             "--generations", "2"]  # fmt: skip
     code, stdout, _ = run_cli(args, capsys)
-    assert code == 0 and "second search: the first fit (" in stdout
-    code, stdout, _ = run_cli([*args, "--json"], capsys)
-    record = json.loads(stdout)["settings"]["second_search_run"]
-    assert code == 0 and record is not None and record["first_fit_nrmse"] > 0
+    stdout = " ".join(stdout.split())  # the console wraps long lines
+    assert code == 0 and "second search: the first fit's NRMSE " in stdout and "x the first: " in stdout
+    code, json_out, _ = run_cli([*args, "--json"], capsys)
+    record = json.loads(json_out)["settings"]["second_search_run"]
+    assert code == 0 and record["trigger"] == 0.0 and record["first_fit_nrmse"] > 0.0
+    # the line says which result was kept, as the record does
+    kept = "its result kept" if record["taken"] else "the first search's result kept"
+    assert kept in stdout
     code, stdout, _ = run_cli([*args, "--json", "--no-second-search"], capsys)
     data = json.loads(stdout)
     assert data["settings"]["second_search"] is False and data["settings"]["second_search_run"] is None
     code, stdout, _ = run_cli([*args, "--no-second-search"], capsys)
     assert "second search" not in stdout
+
+
+def test_the_second_search_help_gives_the_triggers_the_code_uses(capsys):
+    from emaphm.identification.identify import SECOND_SEARCH_NRMSE
+
+    code, stdout, _ = run_cli(["identify", "--help"], capsys)
+    text = " ".join(stdout.replace("│", " ").split())
+    assert code == 0
+    assert (
+        f"NRMSE above {100 * SECOND_SEARCH_NRMSE['default']:g} %; {100 * SECOND_SEARCH_NRMSE['paper']:g} %"
+        in text
+    )
 
 
 def _write_bad_traces(d):

@@ -147,7 +147,7 @@ def identify(
         typer.Option(
             "--second-search/--no-second-search",
             help="With --polish: search again from another seed when the fit is poorer than the monitor's usual "
-            "(NRMSE above 3 %; 5 % with --monitor paper), keeping the better (docs/identification.md).",
+            "(NRMSE above 3 %; 5 % with --monitor paper), keeping the lower eq. 3 fitness (docs/identification.md).",
         ),
     ] = True,
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object to stdout.")] = False,
@@ -275,6 +275,10 @@ def _error_corner(text: str) -> float | str | None:
     return parse_error_corner(value, name="--error-corner")
 
 
+def _percent(fraction: float | None) -> str:
+    return "not finite" if fraction is None else f"{100 * fraction:.2f} %"
+
+
 def _print_identification(data: dict[str, Any]) -> None:
     from .tables import fault_table
 
@@ -288,15 +292,17 @@ def _print_identification(data: dict[str, Any]) -> None:
         out.print(f"%err {data['percent_error']:.2f}")
     if data["fit_nrmse"] is not None:
         out.print(
-            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.5-4 %; "
+            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.4-3.9 %; "
             "above 6 % a warning, above 50 %: does not fit)"
         )
     second = data["settings"].get("second_search_run")
     if second is not None:
+        ratio = second["fitness_ratio"]
         kept = "its result kept" if second["taken"] else "the first search's result kept"
         out.print(
-            f"second search: the first fit ({100 * second['first_fit_nrmse']:.2f} %) was poorer than the monitor's "
-            f"usual; the second fit {100 * second['second_fit_nrmse']:.2f} %, {kept}"
+            f"second search: the first fit's NRMSE {_percent(second['first_fit_nrmse'])} was above the monitor's "
+            f"usual ({100 * second['trigger']:g} %); the second search's fitness "
+            f"{'not finite' if ratio is None else f'{ratio:.3f} x the first'}: {kept}"
         )
     if data["verdict"] != "fits":
         out.print("verdict: does not fit (see the warning): no faults reported")
