@@ -327,3 +327,29 @@ def test_a_campaign_can_turn_the_second_search_off_as_identify_does(tmp_path):
     )
     with pytest.raises(InputError, match="second_search"):
         load_campaign(tmp_path / "c.toml")
+
+
+def test_a_results_row_records_the_second_search(tmp_path, monkeypatch):
+    import json
+
+    from emaphm.campaign.jobs import run_job
+    from emaphm.identification import identify as identify_module
+    from emaphm.identification import optimizers
+
+    # a trigger every fit exceeds and a tiny polish: each job searches twice
+    monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.0)
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    rows = {}
+    for second in ("true", "false"):
+        (tmp_path / "c.toml").write_text(
+            f'[campaign]\nname = "x"\n[identify]\npop_size = 6\ngenerations = 2\nuncertainty = "none"\n'
+            f'second_search = {second}\n[[actuator]]\nid = "a"\nfaults = [0.2,0,0,0,0,0,0,0.5]\n'
+        )
+        (job,) = load_campaign(tmp_path / "c.toml").jobs()
+        rows[second] = run_job(job.to_dict())
+    record = json.loads(rows["true"]["second_search"])
+    assert (
+        record["trigger"] == 0.0
+        and record["first_evaluations"] + record["second_evaluations"] == (rows["true"]["evaluations"])
+    )
+    assert rows["false"]["second_search"] is None

@@ -67,6 +67,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
         "fault_verdicts": None if data["fault_verdicts"] is None else json.dumps(data["fault_verdicts"]),
         "fit_nrmse": data["fit_nrmse"], "fitness": data["fitness"], "evaluations": data["evaluations"],
         "wall_time_s": data["wall_time_s"], "reference": job["reference"],
+        "second_search": None if (second := data["settings"].get("second_search_run")) is None else json.dumps(second),
         "reference_sha256": job["reference_sha256"], "settings": json.dumps(job["settings"], sort_keys=True),
         "warnings": json.dumps(data["warnings"]), "worker": _worker(), "finished": _now(), "version": __version__,
         "numba_threads": _pool(),

@@ -16,7 +16,8 @@ Columns of ``results`` (`RESULT_COLUMNS`): the job's key and coordinates, the es
 ``k1``..``k8``, the truth ``true_k1``..``true_k8`` (null when not known), the uncertainty
 (``std_k*``, ``ci90_low_k*``, ``ci90_high_k*``, ``uq_flags`` and the 8 x 8 ``corr`` as JSON; null when not
 computed), the verdict and the
-detected faults, ``fit_nrmse``, ``fitness``, ``evaluations``, ``wall_time_s``, the reference, the
+detected faults, ``fit_nrmse``, ``fitness``, ``evaluations``, ``wall_time_s``, the second search
+a poor fit started (``second_search``: its record as JSON, null when none ran), the reference, the
 settings (JSON), the worker, the size of its numba thread pool (``numba_threads``: 1 on a
 campaign's workers, so that workers × threads stay within the cores) and the ``version``.
 """
@@ -41,7 +42,7 @@ RESULT_COLUMNS: dict[str, str] = {
     **{f"ci90_high_{k}": "float64" for k in K},
     "uq_method": "string", "uq_flags": "string", "corr": "string", "verdict": "string", "detected": "string", "fault_verdicts": "string",
     "fit_nrmse": "float64", "fitness": "float64", "evaluations": "int64", "wall_time_s": "float64",
-    "reference": "string", "reference_sha256": "string", "settings": "string", "warnings": "string",
+    "second_search": "string", "reference": "string", "reference_sha256": "string", "settings": "string", "warnings": "string",
     "worker": "string", "numba_threads": "int64", "finished": "string", "version": "string",
 }  # fmt: skip
 FAILURE_COLUMNS: dict[str, str] = {
