@@ -275,10 +275,6 @@ def _error_corner(text: str) -> float | str | None:
     return parse_error_corner(value, name="--error-corner")
 
 
-def _percent(fraction: float | None) -> str:
-    return "not finite" if fraction is None else f"{100 * fraction:.2f} %"
-
-
 def _print_identification(data: dict[str, Any]) -> None:
     from .tables import fault_table
 
@@ -300,7 +296,7 @@ def _print_identification(data: dict[str, Any]) -> None:
         ratio = second["fitness_ratio"]
         kept = "its result kept" if second["taken"] else "the first search's result kept"
         out.print(
-            f"second search: the first fit's NRMSE {_percent(second['first_fit_nrmse'])} was above the monitor's "
+            f"second search: the first fit's NRMSE {100 * second['first_fit_nrmse']:.2f} % was above the monitor's "
             f"usual ({100 * second['trigger']:g} %); the second search's fitness "
             f"{'not finite' if ratio is None else f'{ratio:.3f} x the first'}: {kept}"
         )

@@ -13,7 +13,7 @@ import numbers
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -399,7 +399,7 @@ class FaultIdentifier:
 
         start = time.perf_counter()
         first = self._search(evaluate, seed)
-        kept = first
+        kept, evaluations = first, first.run.evaluations
         # a second, independent search when the first one's fit is clearly poorer than the monitor's
         # usual (`SECOND_SEARCH_NRMSE`) while still a fit (`FIT_NRMSE_LIMIT`); the better is kept
         self.second_search_: dict[str, Any] | None = None
@@ -407,27 +407,26 @@ class FaultIdentifier:
             SECOND_SEARCH_NRMSE.get(monitor.monitor) if self.local_polish and self.second_search else None
         )
         if trigger is not None and trigger < first.fit_nrmse <= FIT_NRMSE_LIMIT:
-            second = self._search(evaluate, second_seed(seed))
+            other_seed = second_seed(seed)
+            second = self._search(evaluate, other_seed)
             # the lower eq. 3 fitness decides (the search's own measure), among fits that explain
             # the measurement: a second search whose LF run diverged is never taken
             won = bool(second.run.f < first.run.f and second.fit_nrmse <= FIT_NRMSE_LIMIT)
             kept = second if won else first
             self.second_search_ = {
                 "trigger": trigger,
-                "seed": second_seed(seed),
-                "first_fit_nrmse": _finite(first.fit_nrmse),
+                "seed": other_seed,
+                "first_fit_nrmse": round(first.fit_nrmse, 6),  # finite: it started the search
                 "second_fit_nrmse": _finite(second.fit_nrmse),
                 "fitness_ratio": _finite(second.run.f / first.run.f) if first.run.f > 0 else None,
                 "first_evaluations": first.run.evaluations,
                 "second_evaluations": second.run.evaluations,
                 "taken": won,
             }
-            # the evaluations of both searches; the history (one best per generation) is the kept one's
-            kept.run = OptimizerRun(
-                kept.run.x, kept.run.f, first.run.evaluations + second.run.evaluations, kept.run.history
-            )
+            evaluations += second.run.evaluations
         self.wall_time_ = time.perf_counter() - start
-        run = kept.run
+        # the evaluations of both searches; the history (one best per generation) is the kept one's
+        run = replace(kept.run, evaluations=evaluations)
         # what the kept search did (`_Search`), for the record
         self.runner_up_won_, self.permutation_ = kept.runner_up_won, kept.permutation
         self.short_move_, self.eccentricity_move_ = kept.short_move, kept.eccentricity_move
