@@ -1,0 +1,149 @@
+"""How much a small torque error costs each actuator: the conditioning behind the NRMSE tail (issue 8).
+
+    python benchmarks/tail_conditioning.py [--cases 1000] [--case-seed 9002] [--command chirp]
+                                           [--psi 0.01] [--top 10]
+    python benchmarks/tail_conditioning.py --standstill 300
+
+The monitor's NRMSE at the true faults has a tail (monitor-model.md §4): a few actuators in a
+thousand reach 5-8 % where the median is under 2 %. This script asks whether those actuators are
+the ones where *any* model with a small torque error must err: it runs the HF twin against
+itself with the magnet flux linkage ψ_m changed by ±psi (a torque constant and back-EMF off by
+that fraction, nothing else; noise off), and compares, case by case, that sensitivity with the
+monitor's NRMSE at the truth (the packaged monitor, as `monitor_fidelity.py`).
+
+Printed: median / p90 / p99 / max of each NRMSE over the cases; the sensitivity (the larger of
+the +psi and −psi NRMSE) of the monitor's cases above 4 % against the sensitivity's own
+distribution (its rank); the Spearman rank correlation of the two over all cases; and the --top
+cases by the monitor's NRMSE with their sensitivity. A monitor error that tracks the twin's own
+sensitivity is conditioning (the actuator amplifies a torque error), not a missing term.
+
+--standstill N looks instead at the twin's current while its motor is stuck (the first N cases,
+noise off): over each 2 ms in which ω_m = 0 throughout and |i_q,ref| > 0.12 A (beyond the loop's
+ring at standstill, `monitor.RING_OUTER`·i_D), the mean of i_q − i_q,ref signed against the
+demand (negative: the loop delivers less than asked). The monitor carries a constant shortfall
+there (its loop surrogate's δ_H + δ_2·c₂, `monitor.loop_error`). Printed: its spread, and how much
+of that spread a least-squares fit on what an averaged model could know at that instant (the
+turns lost per phase, the phase directions of the demand and their products, the 6θ_e position on
+the band's hexagon) explains. What no such fit explains is the loop's history (its legs'
+switching state), which no averaged monitor carries.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import platform
+import time
+
+import numpy as np
+from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from scipy.stats import spearmanr
+
+import emaphm
+from emaphm.faults import random_faults
+from emaphm.identification import Comparison
+from emaphm.identification.calibrate import CALIBRATION_COMMANDS
+from emaphm.kernels.transforms import phase_directions
+from emaphm.models import HighFidelityEma, MonitorEma
+from emaphm.params import EmaParams
+
+
+def _stats(v: np.ndarray) -> str:
+    return (
+        f"{np.median(v):5.2f} / {np.percentile(v, 90):5.2f} / {np.percentile(v, 99):5.2f} / {v.max():5.2f} %"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", type=int, default=1000)
+    parser.add_argument("--case-seed", type=int, default=9002)
+    parser.add_argument("--command", default="chirp", choices=tuple(CALIBRATION_COMMANDS))
+    parser.add_argument("--psi", type=float, default=0.01, help="relative change of ψ_m (0.01: 1 %%)")
+    parser.add_argument("--top", type=int, default=10, help="cases listed, by the monitor's NRMSE")
+    parser.add_argument(
+        "--standstill", type=int, default=0, help="N: the stuck-motor shortfall on N cases instead"
+    )
+    args = parser.parse_args()
+    if args.standstill:
+        standstill(args)
+        return
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
+          f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
+          f"HF noise off, ψ_m × (1 ± {args.psi:g})")  # fmt: skip
+    start = time.perf_counter()
+    cases = random_faults(args.cases, args.case_seed)
+    command = CALIBRATION_COMMANDS[args.command]
+    base = EmaParams()
+    hf = HighFidelityEma(base, command=command)
+    refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
+            for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
+    lf = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, MonitorEma(command=command).simulate_many(cases),
+                                                          strict=True)])  # fmt: skip
+    sens = []
+    for sign in (1.0, -1.0):
+        motor = dataclasses.replace(base.motor, psi_m=base.motor.psi_m * (1.0 + sign * args.psi))
+        twin = HighFidelityEma(dataclasses.replace(base, motor=motor), command=command)
+        sens.append(
+            [100 * ref.nrmse(twin.simulate(k, noise=False).i_q) for ref, k in zip(refs, cases, strict=True)]
+        )
+    plus, minus = np.array(sens)
+    worst = np.maximum(plus, minus)
+    print(f"{'NRMSE against the twin, median / p90 / p99 / max':<52}")
+    for label, v in (("monitor at the true faults", lf), (f"twin with ψ_m × (1 + {args.psi:g})", plus),
+                     (f"twin with ψ_m × (1 − {args.psi:g})", minus)):  # fmt: skip
+        print(f"  {label + ':':<36} {_stats(v)}   above 4 %: {int(np.sum(v > 4.0))}")
+    rank = np.argsort(np.argsort(-worst))  # 0: the most sensitive case
+    tail = np.flatnonzero(lf > 4.0)
+    if tail.size:
+        print(f"the monitor's cases above 4 % ({tail.size}): sensitivity median {np.median(worst[tail]):.2f} % "
+              f"against {np.median(worst):.2f} % over all; their ranks among {args.cases} by sensitivity "
+              f"(0: most sensitive): {sorted(int(r) for r in rank[tail])}")  # fmt: skip
+    rho = spearmanr(lf, worst).statistic
+    print(f"Spearman rank correlation, monitor NRMSE vs sensitivity, all cases: {rho:.2f}")
+    print(f"{'case':>5} {'monitor':>8} {'+psi':>7} {'-psi':>7} {'rank':>5}   faults k1..k8")
+    for j in np.argsort(-lf)[: args.top]:
+        print(f"{j:>5} {lf[j]:>7.2f}% {plus[j]:>6.2f}% {minus[j]:>6.2f}% {rank[j]:>5}   "
+              + " ".join(f"{x:.2f}" for x in cases[j]))  # fmt: skip
+    print(f"({time.perf_counter() - start:.0f} s)")
+
+
+def standstill(args: argparse.Namespace) -> None:
+    """The twin's current shortfall while its motor is stuck, and what an averaged model could explain of it."""
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
+          f"({cpu_model()}); {args.standstill} cases (seed {args.case_seed}), command {args.command}, "
+          "HF noise off; windows of 2 ms stuck throughout, |i_q,ref| > 0.12 A")  # fmt: skip
+    start = time.perf_counter()
+    hf = HighFidelityEma(command=CALIBRATION_COMMANDS[args.command])
+    window = round(2e-3 * hf.params.controller.f_s)
+    rows = []
+    for j, k in enumerate(random_faults(args.standstill, args.case_seed)):
+        r = hf.simulate(k, noise=False)
+        for a in range(0, len(r.t) - window, window):
+            s = slice(a, a + window)
+            demand = float(np.mean(r.i_q_ref[s]))
+            if np.all(r.omega_m[s] == 0.0) and abs(demand) > 0.12:
+                u = np.sign(demand) * np.array(phase_directions(np.sin(r.theta_e[a]), np.cos(r.theta_e[a])))
+                N = 1.0 - np.clip(k[2:5], 0.0, 0.95)  # the turn fractions N_x, clamped as the twin does
+                lost = 1.0 - N
+                six = 6.0 * r.theta_e[a]
+                features = [*lost, *(lost * u * u), *(lost * u), np.cos(six), np.sin(six),
+                            N[np.argmax(u)], N[np.argmin(u)]]  # fmt: skip
+                rows.append((j, np.sign(demand) * float(np.mean(r.i_q[s] - r.i_q_ref[s])), *features))
+    data = np.array(rows)
+    shortfall, X = 1e3 * data[:, 1], data[:, 2:]
+    print(f"{len(data)} windows from {len(set(data[:, 0]))} cases: i_q − i_q,ref against the demand "
+          f"median {np.median(shortfall):.1f} mA, p10 {np.percentile(shortfall, 10):.1f}, "
+          f"p90 {np.percentile(shortfall, 90):.1f}, std {shortfall.std():.1f} mA")  # fmt: skip
+    for name, cols in (("turns lost per phase (3)", slice(0, 3)), ("all 13 features", slice(0, 13))):
+        A = np.column_stack([np.ones(len(data)), X[:, cols]])
+        coef, *_ = np.linalg.lstsq(A, shortfall, rcond=None)
+        print(
+            f"  left after a least-squares fit on a constant + {name}: {np.std(shortfall - A @ coef):.1f} mA"
+        )
+    print(f"({time.perf_counter() - start:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
