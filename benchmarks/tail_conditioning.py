@@ -3,6 +3,7 @@
     python benchmarks/tail_conditioning.py [--cases 1000] [--case-seed 9002] [--command chirp]
                                            [--psi 0.01] [--top 10]
     python benchmarks/tail_conditioning.py --standstill 300
+    python benchmarks/tail_conditioning.py --step 2e-6
 
 The monitor's NRMSE at the true faults has a tail (monitor-model.md §4): a few actuators in a
 thousand reach 5-8 % where the median is under 2 %. This script asks whether those actuators are
@@ -26,6 +27,10 @@ of that spread a least-squares fit on what an averaged model could know at that 
 turns lost per phase, the phase directions of the demand and their products, the 6θ_e position on
 the band's hexagon) explains. What no such fit explains is the loop's history (its legs'
 switching state), which no averaged monitor carries.
+
+--step DT compares instead the twin run at another integration step DT (its default 1 µs) with
+itself: a *switching* monitor, the twin's own structure discretised differently, against the
+averaged one (issue 8's "multi-fidelity" option, monitor-model.md §5).
 """
 
 from __future__ import annotations
@@ -65,9 +70,15 @@ def main() -> None:
     parser.add_argument(
         "--standstill", type=int, default=0, help="N: the stuck-motor shortfall on N cases instead"
     )
+    parser.add_argument(
+        "--step", type=float, default=0.0, help="DT [s]: the twin at step DT against itself instead"
+    )
     args = parser.parse_args()
     if args.standstill:
         standstill(args)
+        return
+    if args.step:
+        other_step(args)
         return
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
           f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
@@ -106,6 +117,38 @@ def main() -> None:
     for j in np.argsort(-lf)[: args.top]:
         print(f"{j:>5} {lf[j]:>7.2f}% {plus[j]:>6.2f}% {minus[j]:>6.2f}% {rank[j]:>5}   "
               + " ".join(f"{x:.2f}" for x in cases[j]))  # fmt: skip
+    print(f"({time.perf_counter() - start:.0f} s)")
+
+
+def other_step(args: argparse.Namespace) -> None:
+    """The twin at integration step `args.step` against the twin at its own, and the monitor beside it."""
+    base = EmaParams()
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
+          f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
+          f"HF noise off; the twin at {args.step:g} s against the twin at {base.integration.dt:g} s")  # fmt: skip
+    start = time.perf_counter()
+    cases = random_faults(args.cases, args.case_seed)
+    command = CALIBRATION_COMMANDS[args.command]
+    hf = HighFidelityEma(base, command=command)
+    refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
+            for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
+    lf = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, MonitorEma(command=command).simulate_many(cases),
+                                                          strict=True)])  # fmt: skip
+    other = HighFidelityEma(
+        dataclasses.replace(base, integration=dataclasses.replace(base.integration, dt=args.step)),
+        command=command,
+    )
+    t0 = time.perf_counter()
+    sw = 100 * np.array(
+        [ref.nrmse(other.simulate(k, noise=False).i_q) for ref, k in zip(refs, cases, strict=True)]
+    )
+    per_run = (time.perf_counter() - t0) / len(cases)
+    for label, v in (("monitor at the true faults", lf), (f"twin at {args.step:g} s", sw)):
+        print(f"  {label + ':':<36} {_stats(v)}   above 4 %: {int(np.sum(v > 4.0))}")
+    print(f"the twin at {args.step:g} s: {1e3 * per_run:.1f} ms per run, one thread")
+    print(f"{'case':>5} {'monitor':>8} {'step':>7}   faults k1..k8")
+    for j in np.argsort(-lf)[: args.top]:
+        print(f"{j:>5} {lf[j]:>7.2f}% {sw[j]:>6.2f}%   " + " ".join(f"{x:.2f}" for x in cases[j]))
     print(f"({time.perf_counter() - start:.0f} s)")
 
 
