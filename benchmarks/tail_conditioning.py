@@ -46,6 +46,7 @@ from _machine import cpu_model  # benchmarks/ is the script's folder, first on s
 from scipy.stats import spearmanr
 
 import emaphm
+from emaphm.commands import Command
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS
@@ -84,14 +85,8 @@ def main() -> None:
           f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
           f"HF noise off, ψ_m × (1 ± {args.psi:g})")  # fmt: skip
     start = time.perf_counter()
-    cases = random_faults(args.cases, args.case_seed)
-    command = CALIBRATION_COMMANDS[args.command]
     base = EmaParams()
-    hf = HighFidelityEma(base, command=command)
-    refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
-            for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
-    lf = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, MonitorEma(command=command).simulate_many(cases),
-                                                          strict=True)])  # fmt: skip
+    cases, command, refs, lf = _at_the_truth(args, base)
     sens = []
     for sign in (1.0, -1.0):
         motor = dataclasses.replace(base.motor, psi_m=base.motor.psi_m * (1.0 + sign * args.psi))
@@ -120,6 +115,20 @@ def main() -> None:
     print(f"({time.perf_counter() - start:.0f} s)")
 
 
+def _at_the_truth(
+    args: argparse.Namespace, base: EmaParams
+) -> tuple[np.ndarray, Command, list[Comparison], np.ndarray]:
+    """The cases, their command, the twin's filtered currents (noise off) and the monitor's NRMSE at the truth [%]."""
+    cases = random_faults(args.cases, args.case_seed)
+    command = CALIBRATION_COMMANDS[args.command]
+    hf = HighFidelityEma(base, command=command)
+    refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
+            for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
+    currents = MonitorEma(command=command).simulate_many(cases)
+    lf = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, currents, strict=True)])
+    return cases, command, refs, lf
+
+
 def other_step(args: argparse.Namespace) -> None:
     """The twin at integration step `args.step` against the twin at its own, and the monitor beside it."""
     base = EmaParams()
@@ -127,13 +136,7 @@ def other_step(args: argparse.Namespace) -> None:
           f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
           f"HF noise off; the twin at {args.step:g} s against the twin at {base.integration.dt:g} s")  # fmt: skip
     start = time.perf_counter()
-    cases = random_faults(args.cases, args.case_seed)
-    command = CALIBRATION_COMMANDS[args.command]
-    hf = HighFidelityEma(base, command=command)
-    refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
-            for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
-    lf = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, MonitorEma(command=command).simulate_many(cases),
-                                                          strict=True)])  # fmt: skip
+    cases, command, refs, lf = _at_the_truth(args, base)
     other = HighFidelityEma(
         dataclasses.replace(base, integration=dataclasses.replace(base.integration, dt=args.step)),
         command=command,
