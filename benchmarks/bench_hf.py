@@ -3,12 +3,17 @@
 Target ≤ 0.15 s, goal ≤ 0.05 s. Run:
 
     python benchmarks/bench_hf.py [--repeats 5]
+    python benchmarks/bench_hf.py --batch 40 [--repeats 5]
 
 The first call loads (or compiles) the numba kernels and is reported apart; the figure is the
 median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs), and
 the same median as nanoseconds per integration step (wall time of the whole `simulate` call over
 the number of Δt steps, sub-steps included). The last column is the process CPU time per
 simulated second (median): on a shared, busy machine it moves less than the wall time.
+
+--batch N times instead `HighFidelityEma.simulate_batch` on N random fault rows (seed 9002,
+noise off), on 1 thread and on 2 (the kernel releases the GIL), alternating, --repeats rounds:
+the medians and their ratio.
 """
 
 from __future__ import annotations
@@ -35,7 +40,11 @@ CASES = {
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--batch", type=int, default=0, help="N: time a batch of N runs on 1 and 2 threads")
     args = parser.parse_args()
+    if args.batch:
+        batch(args)
+        return
 
     t0 = time.perf_counter()
     emaphm.simulate(emaphm.HEALTHY, duration=0.01)
@@ -66,6 +75,27 @@ def main() -> None:
             f"{statistics.median(per):>22.4f} {min(per):>7.4f} {max(per):>7.4f}"
             f" {statistics.median(per) * dt * 1e9:>17.1f} {statistics.median(cpus) / sim_s:>12.4f}"
         )
+
+
+def batch(args: argparse.Namespace) -> None:
+    """`simulate_batch` of args.batch random rows on 1 thread and on 2, alternating."""
+    from emaphm.faults import random_faults
+
+    K = random_faults(args.batch, 9002)
+    twin = emaphm.HighFidelityEma()
+    twin.simulate_batch(K[:2], noise=False, workers=2)  # compile or cache load
+    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores; "
+          f"simulate_batch of {args.batch} random rows (seed 9002), noise off, {args.repeats} rounds")  # fmt: skip
+    walls: dict[int, list[float]] = {1: [], 2: []}
+    for _ in range(args.repeats):
+        for workers in (1, 2):
+            t0 = time.perf_counter()
+            twin.simulate_batch(K, noise=False, workers=workers)
+            walls[workers].append(time.perf_counter() - t0)
+    one, two = statistics.median(walls[1]), statistics.median(walls[2])
+    print(f"1 thread: {one:.2f} s ({1e3 * one / args.batch:.1f} ms per run); 2 threads: {two:.2f} s "
+          f"({1e3 * two / args.batch:.1f} ms per run); speed-up {one / two:.2f}x (medians; per round "
+          + ", ".join(f"{a / b:.2f}" for a, b in zip(walls[1], walls[2], strict=True)) + ")")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -180,6 +180,28 @@ def test_same_seed_same_output_other_seed_differs():
     assert a.metadata["seed"] == 7 and a.metadata["noise"] is True
 
 
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_batch_on_threads_is_each_run_to_the_bit(workers):
+    # different faults (sub-step counts), seeds and noise per row; threads must not mix runs up
+    K = [HEALTHY, faults(k3=0.6, k6=0.2), faults(k1=0.5, k2=0.4), faults(k4=0.9)]
+    twin = emaphm.HighFidelityEma()
+    batch = twin.simulate_batch(K, seeds=[3, 1, 4, 1], duration=0.03, workers=workers)
+    for k, seed, got in zip(K, [3, 1, 4, 1], batch, strict=True):
+        alone = twin.simulate(k, seed=seed, duration=0.03)
+        for name in alone.names:
+            np.testing.assert_array_equal(got[name], alone[name])
+        assert got.metadata["seed"] == seed
+    assert not np.array_equal(batch[0].i_q, batch[1].i_q)
+
+
+def test_a_batch_refuses_seeds_that_do_not_match_its_rows():
+    twin = emaphm.HighFidelityEma()
+    with pytest.raises(emaphm.InputError, match="seeds has 1 values for 2 fault rows"):
+        twin.simulate_batch([HEALTHY, HEALTHY], seeds=[1], duration=0.01)
+    with pytest.raises(emaphm.InputError, match="seed must be"):
+        twin.simulate_batch([HEALTHY], seeds=[-1], duration=0.01)
+
+
 def test_noise_off_ignores_the_seed():
     a = emaphm.simulate(HEALTHY, noise=False, seed=1, duration=0.05)
     b = emaphm.simulate(HEALTHY, noise=False, seed=2, duration=0.05)

@@ -98,13 +98,14 @@ if KernelCacheLocator not in _CACHE_IMPL._locator_classes:
 CACHE_ENABLED = _writable(kernel_cache_dir() / __name__.split(".", 1)[0])
 
 
-def jit(fn: F | None = None, *, parallel: bool = False) -> Any:
-    """``numba.njit`` with the project's settings.
+def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False) -> Any:
+    """``numba.njit`` with the project's settings; with `nogil` the compiled function releases
+    the GIL, so Python threads run it side by side (`HighFidelityEma.simulate_batch`).
 
     ``cache=True`` keeps compiled code on disk between runs (in `kernel_cache_dir`, keyed by all
     kernel sources); ``error_model="numpy"`` drops the division-by-zero checks from the hot loops
     (the API validates the divisors, and the model layer checks outputs for NaN/inf);
     ``fastmath`` stays off so results are bit-reproducible.
     """
-    decorator = njit(cache=CACHE_ENABLED, parallel=parallel, error_model="numpy")
+    decorator = njit(cache=CACHE_ENABLED, parallel=parallel, nogil=nogil, error_model="numpy")
     return decorator if fn is None else decorator(fn)

@@ -101,7 +101,7 @@ def _comparators(i_a, i_b, i_c, s_a, s_b, s_c, lo_a, lo_b, lo_c, hi_a, hi_b, hi_
     return s_a, s_b, s_c, switched
 
 
-@jit
+@jit(nogil=True)  # a batch of runs on Python threads (`HighFidelityEma.simulate_batch`)
 def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_per_sample, n_sub, out):  # type: ignore[no-untyped-def]
     """Run the HF twin over len(theta_cmd) samples, writing `out` (shape (n, N_OUT)).
 

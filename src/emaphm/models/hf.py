@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InputError
-from ..faults import HEALTHY, FaultedParameters, apply_faults, as_fault_vector
+from ..faults import HEALTHY, FaultedParameters, apply_faults, as_fault_matrix, as_fault_vector
 from ..kernels.hf_twin import N_OUT, OUT_COLUMNS, simulate_hf
 from ..kernels.pmsm_abc import StatorPack, stator_pack
 from ..kernels.sensors import adc
@@ -63,6 +65,39 @@ class HighFidelityEma(_EmaModel):
                 f"at most {MAX_SUBSTEPS}: check L_s, h and dt"
             )
         return n_sub
+
+    def simulate_batch(
+        self,
+        K: ArrayLike,
+        *,
+        noise: bool = True,
+        seeds: Sequence[int] | None = None,
+        duration: float | None = None,
+        workers: int | None = None,
+    ) -> list[SimResult]:
+        """`simulate` for each fault row of K (seeds[j] for row j; 0 for all when None), the runs
+        side by side on `workers` threads (None or 0: numba's thread count, `numba_threads`).
+
+        Each result is the one `simulate` gives for that row and seed, to the bit: the kernel
+        releases the GIL, and nothing is shared between runs but the read-only command.
+        """
+        import numba
+
+        rows = as_fault_matrix(K)
+        seeds = [0] * len(rows) if seeds is None else [check_seed(s) for s in seeds]
+        if len(seeds) != len(rows):
+            raise InputError(f"seeds has {len(seeds)} values for {len(rows)} fault rows")
+        if workers is not None and workers < 0:
+            raise InputError(f"workers must be 0 or more, got {workers}")
+        threads = min(workers or numba.get_num_threads(), len(rows)) or 1
+        if threads == 1:
+            return [
+                self.simulate(k, noise=noise, seed=s, duration=duration)
+                for k, s in zip(rows, seeds, strict=True)
+            ]
+        with ThreadPoolExecutor(threads) as pool:
+            return list(pool.map(lambda ks: self.simulate(ks[0], noise=noise, seed=ks[1], duration=duration),
+                                 zip(rows, seeds, strict=True)))  # fmt: skip
 
     def simulate(
         self,
