@@ -172,19 +172,21 @@ def hf_references(
 ) -> list[Comparison]:
     """Filtered HF i_q of each scenario on the sample grid of its command (the runs of one
     command side by side, `HighFidelityEma.simulate_batch`)."""
-    out: list[Comparison | None] = [None] * len(scenarios)
-    done = 0
+    out: dict[int, Comparison] = {}
     for command in dict.fromkeys(sc.command for sc in scenarios):
         js = [j for j, sc in enumerate(scenarios) if sc.command == command]
         runs = HighFidelityEma(params, commands[command]).simulate_batch(
             [scenarios[j].faults for j in js], noise=noise, seeds=[seed] * len(js)
         )
-        for j, r in zip(js, runs, strict=True):
-            out[j] = Comparison.from_signal(r.t, r.i_q, params.controller.f_s)
-        done += len(js)
+        out.update(
+            {
+                j: Comparison.from_signal(r.t, r.i_q, params.controller.f_s)
+                for j, r in zip(js, runs, strict=True)
+            }
+        )
         if progress:
-            progress(f"HF scenarios ({'noise on' if noise else 'noise off'})", done, len(scenarios))
-    return [c for c in out if c is not None]
+            progress(f"HF scenarios ({'noise on' if noise else 'noise off'})", len(out), len(scenarios))
+    return [out[j] for j in range(len(scenarios))]
 
 
 def scenario_nrmse(
