@@ -4,6 +4,7 @@
                                           [--monitor default|paper] [--command chirp|chirp-2s|chirp-hold|steps]
                                           [--starts 2 --pop-size 64 --generations 30]
                                           [--params ACTUATOR.toml --calibration CAL.json] [--best-from EARLIER.txt]
+                                          [--last-stage auto|switching|none]
 
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) drawn from --case-seed, a seed of this
 script's own (the calibration and `bench_identify.py` use others). Each case is identified with
@@ -15,11 +16,14 @@ the default one). --starts N runs N independent identifications per measurement 
 s, 5000 + s, ...; each with --pop-size x --generations and its polish) and keeps the best: a
 candidate search scheme against wrong basins (BENCHMARKS.md), not what `emaphm identify` does.
 --params and --calibration run another actuator (an actuator file, issue 10) on its own twin with
-its own calibration (``emaphm calibrate --params``).
+its own calibration (``emaphm calibrate --params``). --last-stage is identify's (the switching
+last stage, `emaphm.identification.switching`; "auto": with the default monitor).
 
 Printed per case and in summary:
 - LF-vs-HF NRMSE at the truth (noise off, 150 Hz filtered): the monitor's bias for that actuator,
-  over the whole trace and ("cmp") over the samples the identification compares;
+  over the whole trace and ("cmp") over the samples the identification compares; in the summary
+  also the switching model's (`switching.SwitchingModel`, the model the last stage fits with)
+  against the twin over the compared samples;
 - %err of each run, median / p90 / max over all runs, and runs above 10 %err;
 - wrong basins: a run whose final fitness exceeds 1.2x the best fitness found for its measurement
   by a reference search (the run itself plus --restarts more identifications of the same
@@ -49,6 +53,7 @@ from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.identify import SECOND_SEARCH_NRMSE, FaultIdentifier
 from emaphm.identification.signals import nrmse as nrmse_of
+from emaphm.identification.switching import LAST_STAGES, SwitchingModel
 from emaphm.models import HighFidelityEma, MonitorEma
 
 
@@ -57,11 +62,18 @@ def noise_seed_of(seed: int) -> int:
     return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
 
 
-def fitness_at(trace: emaphm.SimResult, K: np.ndarray, monitor: MonitorEma) -> np.ndarray:
+def fitness_at(
+    trace: emaphm.SimResult, K: np.ndarray, monitor: MonitorEma, switching: SwitchingModel | None = None
+) -> np.ndarray:
     """Eq. (3) fitness of fault rows K on a measured trace: the identification's own objective
-    (the same grid, filter and compared samples, `FaultIdentifier.prepare`)."""
+    (the same grid, filter and compared samples, `FaultIdentifier.prepare`), of the monitor's
+    current, or of the switching model's when given (what a run with the last stage reports)."""
     command = SampledCommand(trace.t - trace.t[0], trace.theta_cmd)
     ident = FaultIdentifier("ga", monitor=monitor).prepare(trace.t, trace.i_q, command, trace.theta_u)
+    if switching is not None:
+        return np.array(
+            [ident.objective_(switching.current(k, duration=ident.duration_, workers=2)) for k in K]
+        )
     return ident.objective_.of_monitor(ident.monitor_, K, duration=ident.duration_)
 
 
@@ -102,6 +114,7 @@ def main() -> None:
     )
     parser.add_argument("--params", default=None, help="actuator file (default: the nominal actuator)")
     parser.add_argument("--calibration", default=None, help="its LF calibration (default: the packaged one)")
+    parser.add_argument("--last-stage", default="auto", choices=LAST_STAGES, help="identify's last stage")
     args = parser.parse_args()
     params = resolve_params(args.params)
     cpu = cpu_model()
@@ -109,7 +122,8 @@ def main() -> None:
           f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
           f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}, "
           f"{args.starts} start(s) of pop {args.pop_size or 'default'} x {args.generations or 'default'}; "
-          f"actuator {args.params or 'nominal'} ({params_hash(params)}), calibration {args.calibration or 'packaged'}")  # fmt: skip
+          f"actuator {args.params or 'nominal'} ({params_hash(params)}), calibration {args.calibration or 'packaged'}, "
+          f"last stage {args.last_stage}")  # fmt: skip
     earlier = best_from(args.best_from) if args.best_from else {}
     cases = random_faults(args.cases, args.case_seed)
     command = CALIBRATION_COMMANDS[args.command]
@@ -117,6 +131,7 @@ def main() -> None:
     hf = HighFidelityEma(params, command)
     errs, walls, wrong, bias_runs, nrmses, nrmses_cmp = [], [], 0, 0, [], []
     fits, second_runs, second_taken = [], 0, 0
+    switching, nrmses_switching, stage_taken = SwitchingModel(params, command), [], 0
     print(
         f"{'case':>4} {'NRMSE':>6} {'cmp':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'fit':>6} {'wall':>5}  shorts"
     )
@@ -133,6 +148,8 @@ def main() -> None:
         keep = seen.mask_ > 0
         at_truth = seen.reference_.filtered(seen.monitor_.simulate(k, duration=seen.duration_).i_q)
         nrmses_cmp.append(float(nrmse_of(seen.reference_.reference[keep], at_truth[keep])))
+        sw_truth = seen.reference_.filtered(switching.current(k, duration=seen.duration_, workers=2))
+        nrmses_switching.append(float(nrmse_of(seen.reference_.reference[keep], sw_truth[keep])))
         for s in range(1, args.seeds + 1):
             trace = hf.simulate(k, noise=True, seed=noise_seed_of(s))
             t0 = time.perf_counter()
@@ -140,7 +157,7 @@ def main() -> None:
                 emaphm.identify(
                     reference=trace, seed=s + 5000 * q, optimizer=args.optimizer, monitor=args.monitor,
                     pop_size=args.pop_size, generations=args.generations, params=params,
-                    calibration=monitor.calibration,
+                    calibration=monitor.calibration, last_stage=args.last_stage,
                 )
                 for q in range(args.starts)
             ]  # fmt: skip
@@ -156,11 +173,13 @@ def main() -> None:
                     monitor=args.monitor,
                     params=params,
                     calibration=monitor.calibration,
+                    last_stage=args.last_stage,
                 ).fitness
                 for r in range(1, args.restarts + 1)
             ]
             f_best = min([run.fitness, *others, earlier.get((j, s), np.inf)])
-            f_true = float(fitness_at(trace, k[None, :], monitor)[0])
+            on_switching = run.settings["last_stage"] == "switching"
+            f_true = float(fitness_at(trace, k[None, :], monitor, switching if on_switching else None)[0])
             is_wrong = run.fitness > 1.2 * f_best
             fits.append(run.fit_nrmse)
             second = run.settings["second_search_run"]
@@ -171,6 +190,9 @@ def main() -> None:
                 if second is None
                 else f"  2nd search {'taken' if second['taken'] else 'not taken'} (first fit {100 * second['first_fit_nrmse']:.2f}%)"
             )
+            stage = run.settings["switching_stage"]
+            stage_taken += bool(stage and stage["taken"])
+            mark += "" if stage is None else f"  stage {'taken' if stage['taken'] else 'not taken'}"
             wrong += is_wrong
             bias_runs += f_true > run.fitness
             print(f"{j:>4} {100 * nrmse:>5.2f}% {100 * nrmses_cmp[-1]:>5.2f}% {s:>4} {err:>6.2f} {run.fitness:>8.4f} {f_best:>8.4f} {f_true:>8.4f} "
@@ -182,6 +204,8 @@ def main() -> None:
           f"p90 {100 * float(np.percentile(nrmses, 90)):.2f} %, max {100 * max(nrmses):.2f} %")  # fmt: skip
     print(f"the same over the compared samples: median {100 * statistics.median(nrmses_cmp):.2f} %, "
           f"p90 {100 * float(np.percentile(nrmses_cmp, 90)):.2f} %, max {100 * max(nrmses_cmp):.2f} %")  # fmt: skip
+    print(f"the switching model against the twin there: median {100 * statistics.median(nrmses_switching):.2f} %, "
+          f"p90 {100 * float(np.percentile(nrmses_switching, 90)):.2f} %, max {100 * max(nrmses_switching):.2f} %")  # fmt: skip
     print(f"%err over {n} runs: median {statistics.median(errs):.2f}, p90 {float(np.percentile(errs, 90)):.2f}, "
           f"max {max(errs):.2f}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
     print(f"wrong basins (final fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
@@ -189,6 +213,7 @@ def main() -> None:
     print(f"fit NRMSE over the compared samples: median {100 * statistics.median(fits):.2f} %, "
           f"p90 {100 * float(np.percentile(fits, 90)):.2f} %, max {100 * max(fits):.2f} %; "
           f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[args.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
+    print(f"switching last stage ({args.last_stage}) moved the estimate in {stage_taken} of {n} runs")
     print(f"wall time per identification: median {statistics.median(walls):.1f} s, max {max(walls):.1f} s")
 
 

@@ -110,13 +110,15 @@ def test_entry_point_is_installed():
 def test_cli_literals_match_the_code():
     # the CLI keeps these as literals so that it starts without numpy
     from emaphm import HEALTHY
-    from emaphm.cli import COMMAND_NAMES, HEALTHY_TEXT, UQ_METHOD_NAMES
+    from emaphm.cli import COMMAND_NAMES, HEALTHY_TEXT, LAST_STAGE_NAMES, UQ_METHOD_NAMES
     from emaphm.commands import COMMANDS
+    from emaphm.identification.switching import LAST_STAGES
     from emaphm.identification.uncertainty import UQ_METHODS
 
     assert [float(v) for v in HEALTHY_TEXT.split(",")] == list(HEALTHY)
     assert tuple(COMMAND_NAMES) == tuple(COMMANDS)
     assert UQ_METHOD_NAMES == UQ_METHODS
+    assert LAST_STAGE_NAMES == LAST_STAGES
 
 
 def test_cli_starts_without_the_numerical_stack():

@@ -45,6 +45,7 @@ err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, a
 HEALTHY_TEXT = "0,0,0,0,0,0,0,0.5"  # emaphm.faults.HEALTHY
 COMMAND_NAMES = ("chirp", "chirp-hold", "steps", "step", "ramp", "sine")  # emaphm.commands.COMMANDS
 UQ_METHOD_NAMES = ("none", "laplace", "mcmc")  # emaphm.identification.uncertainty.UQ_METHODS
+LAST_STAGE_NAMES = ("auto", "switching", "none")  # emaphm.identification.switching.LAST_STAGES
 
 
 def _status(message: str) -> Any:
@@ -181,6 +182,14 @@ def identify(
             "default monitor's measured corner; none with --monitor paper) or 'off' (the paper's eq. 3)."
         ),
     ] = "auto",
+    last_stage: Annotated[
+        str,
+        typer.Option(
+            help="With --polish, after the search: 'switching' corrects the monitor's bias near the estimate by the twin's "
+            "switching drive (about 1 s more), 'none' skips it, 'auto' (default) runs it with the default "
+            "monitor, not with --monitor paper (docs/identification.md)."
+        ),
+    ] = "auto",
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current.
 
@@ -202,6 +211,8 @@ def identify(
     check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     check_seed(seed)
     corner = _error_corner(error_corner)
+    if last_stage not in LAST_STAGE_NAMES:
+        raise InputError(f"unknown --last-stage {last_stage!r}; use one of {', '.join(LAST_STAGE_NAMES)}")
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
     if reference is not None and map_file is None:
         check_trace_path(reference, for_writing=False)
@@ -230,7 +241,7 @@ def identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
             generations=generations, local_polish=polish, second_search=second_search, calibration=calibration, monitor=monitor,
             uncertainty=uncertainty, uq_calibration=uq_calibration, params=params, channel_map=map_file,
-            error_corner_hz=corner,
+            error_corner_hz=corner, last_stage=last_stage,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
             ),

@@ -343,7 +343,7 @@ def test_a_results_row_records_the_second_search(tmp_path, monkeypatch):
     for second in ("true", "false"):
         (tmp_path / "c.toml").write_text(
             f'[campaign]\nname = "x"\n[identify]\npop_size = 6\ngenerations = 2\nuncertainty = "none"\n'
-            f'second_search = {second}\n[[actuator]]\nid = "a"\nfaults = [0.2,0,0,0,0,0,0,0.5]\n'
+            f'second_search = {second}\nlast_stage = "none"\n[[actuator]]\nid = "a"\nfaults = [0.2,0,0,0,0,0,0,0.5]\n'
         )
         (job,) = load_campaign(tmp_path / "c.toml").jobs()
         rows[second] = run_job(job.to_dict())

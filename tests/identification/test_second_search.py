@@ -61,7 +61,7 @@ def test_a_poor_fit_searches_again_and_keeps_the_lower_fitness(trace, monkeypatc
     monkeypatch.setattr(
         FaultIdentifier, "_search", canned({7: (0.1, FIRST_F, first_fit, 100), other: (*second, 37)})
     )
-    ident = FaultIdentifier(seed=7).fit(trace.t, trace.i_q, Chirp())
+    ident = FaultIdentifier(seed=7, last_stage="none").fit(trace.t, trace.i_q, Chirp())
     record = ident.second_search_
     x, f, fit = second
     assert record is not None and record["taken"] is taken and record["seed"] == other
@@ -93,7 +93,7 @@ def test_a_poor_fit_searches_again_and_keeps_the_lower_fitness(trace, monkeypatc
 def test_no_second_search_where_it_cannot_help_or_was_not_asked(trace, monkeypatch, fit, settings):
     # any other seed than the first's: KeyError
     monkeypatch.setattr(FaultIdentifier, "_search", canned({7: (0.1, 1.0, fit, 100)}))
-    ident = FaultIdentifier(seed=7, **settings).fit(trace.t, trace.i_q, Chirp())
+    ident = FaultIdentifier(seed=7, last_stage="none", **settings).fit(trace.t, trace.i_q, Chirp())
     assert ident.second_search_ is None and ident.run_.evaluations == 100
 
 
@@ -109,7 +109,7 @@ def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
     )
     ran = {}
     for name in ("default", "paper"):
-        ident = FaultIdentifier(seed=7, monitor=MonitorEma(monitor=name)).fit(trace.t, trace.i_q, Chirp())
+        ident = FaultIdentifier(seed=7, last_stage="none", monitor=MonitorEma(monitor=name)).fit(trace.t, trace.i_q, Chirp())
         ran[name] = ident.second_search_
     assert ran["paper"] is None and ran["default"]["trigger"] == SECOND_SEARCH_NRMSE["default"]
 
@@ -120,12 +120,12 @@ def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monk
     monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
     monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.01)
     budget = {"pop_size": 16, "generations": 3}
-    res = identify(reference=trace, seed=3, uncertainty="none", **budget)
+    res = identify(reference=trace, seed=3, uncertainty="none", last_stage="none", **budget)
     record = res.settings["second_search_run"]
     assert res.settings["second_search"] is True and record is not None
     first_seed = res.settings["optimizer_seed"]
     alone = [
-        FaultIdentifier(seed=s, second_search=False, **budget).fit(trace.t, trace.i_q, Chirp())
+        FaultIdentifier(seed=s, second_search=False, last_stage="none", **budget).fit(trace.t, trace.i_q, Chirp())
         for s in (first_seed, second_seed(first_seed))
     ]
     assert alone[0].fit_nrmse_ > 0.01
@@ -136,7 +136,7 @@ def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monk
     np.testing.assert_allclose(res.estimate, best.faults_, atol=1e-6)
     assert res.evaluations == alone[0].run_.evaluations + alone[1].run_.evaluations
     assert res.settings["generations_run"] == len(best.run_.history)  # the kept search's
-    off = identify(reference=trace, seed=3, uncertainty="none", second_search=False, **budget)
+    off = identify(reference=trace, seed=3, uncertainty="none", last_stage="none", second_search=False, **budget)
     assert (
         off.settings["second_search"] is False
         and off.settings["second_search_run"] is None

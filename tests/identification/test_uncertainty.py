@@ -199,7 +199,7 @@ def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
     objective = LinearObjective(fit)
 
     class Ident:
-        faults_, monitor_, duration_, objective_ = truth, monitor, None, objective
+        faults_, monitor_, duration_, objective_, final_objective_ = truth, monitor, None, objective, objective
 
     local = laplace(fit, monitor, truth)  # type: ignore[arg-type]
     runs = [

@@ -91,6 +91,7 @@ IDENTIFY_KEYS = {
     "optimizer": str, "pop_size": int, "generations": int, "polish": bool, "second_search": bool, "uncertainty": str,
     "monitor": str, "calibration": Path, "uq_calibration": Path, "params": Path,
     "error_corner": float,  # "auto", "off" or Hz, as identify --error-corner
+    "last_stage": str,  # "auto", "switching" or "none", as identify --last-stage
 }  # fmt: skip
 ACTUATOR_KEYS = {"id", "faults", "reference", "references", "map", "flights", "start", "growth", "law", "params",
                  "calibration"}  # fmt: skip
@@ -419,6 +420,10 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
         raise _fail(where, f"[identify] {exc}") from None
     if out.get("uncertainty", "laplace") not in UQ_METHODS:
         raise _fail(where, f"[identify] uncertainty must be one of {', '.join(UQ_METHODS)}")
+    from ..identification.switching import LAST_STAGES
+
+    if out.get("last_stage", "auto") not in LAST_STAGES:
+        raise _fail(where, f"[identify] last_stage must be one of {', '.join(LAST_STAGES)}")
     return out
 
 

@@ -18,7 +18,9 @@ as ``fitness(monitor.simulate_many(K, check=False))`` without the serial filter 
 
 from __future__ import annotations
 
+import copy
 import itertools
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -294,6 +296,17 @@ class Fitness:
             self.weights = self.weights * e
         # the comparison filter (`signals.lowpass`) for the fused kernel: sosfiltfilt's defaults
         self.sos, self.zi, self.padlen = comparison_filter(reference.f_s)
+
+    def shifted(self, offset: ArrayLike) -> Fitness:
+        """The same eq. 3 (weights, mask, filter) against the reference less `offset` [A] per
+        sample: the score of a model whose filtered current is corrected by `offset`
+        (`switching.space_mapping`). The weights stay the measurement's own."""
+        d = np.asarray(offset, dtype=np.float64)
+        if d.shape != self.weights.shape:
+            raise ValueError(f"offset has shape {d.shape}, the reference {self.weights.shape}")
+        out = copy.copy(self)
+        out.reference = replace(self.reference, reference=self.reference.reference - d)
+        return out
 
     def __call__(self, currents: ArrayLike) -> NDArray[np.float64]:
         residual = self.reference.reference - self.reference.filtered(currents)

@@ -58,6 +58,7 @@ from .optimizers import (
     run_optimizer,
 )
 from .signals import Comparison, nrmse
+from .switching import LAST_STAGES, SwitchingModel, resolve_last_stage, space_mapping
 from .uncertainty import UQ_METHODS, Factors, Uncertainty, laplace, load_factors, verdicts
 
 __all__ = [
@@ -242,6 +243,12 @@ class FaultIdentifier:
         for those runs); `second_search_` records it (None: not run).
     slope_unit : {"s", "ms"}
         Time unit of the slope in the eq. (3) weights.
+    last_stage : {"auto", "switching", "none"}
+        "switching" (with `local_polish`): after the search, correct the monitor's bias near the estimate by the twin's
+        switching drive at other integration steps (`switching.space_mapping`, ≈ 1 s more);
+        the fitness and fit NRMSE are then the switching model's at the estimate, and
+        `switching_` records the stage. "auto": the switching stage with the default monitor,
+        none with the paper's.
     error_corner_hz : float, None or "auto"
         Corner f_c [Hz] of `fitness.error_weights`, which weight eq. (3) by 1/(1 + (f/f_c)²) of
         the command's local frequency f: where the monitor is known to err more, a sample pulls
@@ -264,11 +271,14 @@ class FaultIdentifier:
         rtol: float = 1e-3,
         local_polish: bool = True,
         second_search: bool = True,
+        last_stage: str = "auto",
         slope_unit: str = "s",
         error_corner_hz: float | str | None = "auto",
         monitor: MonitorEma | None = None,
         on_generation: OnGeneration | None = None,
     ) -> None:
+        if last_stage not in LAST_STAGES:
+            raise InputError(f"unknown last stage {last_stage!r}; use one of {', '.join(LAST_STAGES)}")
         self.optimizer = optimizer
         self.seed = seed
         self.pop_size = pop_size
@@ -277,6 +287,7 @@ class FaultIdentifier:
         self.rtol = rtol
         self.local_polish = local_polish
         self.second_search = second_search
+        self.last_stage = last_stage
         self.slope_unit = slope_unit
         self.error_corner_hz = error_corner_hz
         self.monitor = monitor
@@ -424,19 +435,55 @@ class FaultIdentifier:
                 "taken": won,
             }
             evaluations += second.run.evaluations
-        self.wall_time_ = time.perf_counter() - start
         # the evaluations of both searches; the history (one best per generation) is the kept one's
         run = replace(kept.run, evaluations=evaluations)
         # what the kept search did (`_Search`), for the record
         self.runner_up_won_, self.permutation_ = kept.runner_up_won, kept.permutation
         self.short_move_, self.eccentricity_move_ = kept.short_move, kept.eccentricity_move
         self.least_squares_gain_ = kept.least_squares_gain
-        self.faults_ = as_fault_vector(search_to_faults(run.x[None, :])[0])
-        self.fitness_ = run.f
-        self.run_ = run
+        x, self.fitness_ = run.x, run.f
         # how well the best LF current explains the compared samples (both filtered), for the verdict
         self.fit_nrmse_, self.fitted_ = kept.fit_nrmse, kept.fitted
+        # eq. 3 as the intervals see it: the monitor's, or the corrected monitor's after the last stage
+        self.final_objective_ = fitness
+        # the last stage polishes too: none without the polish (a raw search stays raw)
+        self.last_stage_ = resolve_last_stage(self.last_stage, monitor.monitor) if self.local_polish else "none"
+        self.switching_: dict[str, Any] | None = None
+        if self.last_stage_ == "switching" and explains(kept.fit_nrmse):
+            x, more = self._switching_stage(recentre_phase(run).x)
+            run = replace(run, evaluations=run.evaluations + more)
+        self.wall_time_ = time.perf_counter() - start
+        self.faults_ = as_fault_vector(search_to_faults(x[None, :])[0])
+        self.run_ = run
         return self
+
+    def _switching_stage(self, x0: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:
+        """The switching last stage from the search's point x0 (`switching.space_mapping`): sets
+        the fitness, fit NRMSE and fitted current to the switching model's at the final estimate,
+        the corrected eq. 3 for the intervals and `switching_`; returns the final point and the
+        monitor's evaluations it took."""
+        import numba
+
+        monitor, duration = self.monitor_, self.duration_
+        model = SwitchingModel(monitor.params, monitor.command)
+        workers = numba.get_num_threads()
+        try:
+            stage = space_mapping(
+                self.objective_,
+                self.residuals,
+                lambda k: monitor.simulate(k, duration=duration).i_q,
+                lambda k: model.current(k, duration=duration, workers=workers),
+                search_to_faults,
+                x0,
+            )
+        except SimulationError as exc:  # the switching model diverged at the search's estimate
+            self.switching_ = {"steps_s": list(model.steps), "taken": False, "error": str(exc)}
+            return x0, 0
+        self.fitness_, self.fit_nrmse_ = stage.fitness, stage.fit_nrmse
+        self.fitted_ = self.reference_.filtered(stage.current)
+        self.final_objective_ = stage.objective
+        self.switching_ = stage.record(model.steps)
+        return stage.x, stage.evaluations
 
     def _search(self, evaluate: Callable[[NDArray[np.float64]], NDArray[np.float64]], seed: int) -> _Search:
         """One whole search from `seed`: the optimiser, the polish of its best point and runner-up,
@@ -469,13 +516,17 @@ class FaultIdentifier:
         return _Search(run, fit_nrmse, fitted, runner_up_won, permutation, short_move, eccentricity_move,
                        least_squares_gain)  # fmt: skip
 
-    def residuals(self) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+    def residuals(
+        self, objective: Fitness | None = None
+    ) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
         """Eq. (3)'s residual vectors r = √w·(I_ref − I_LF) over the compared samples for rows X
-        in the search box (after `prepare`): Σ r² per row is ``objective_`` of those faults."""
-        monitor, duration, fitness = self.monitor_, self.duration_, self.objective_
+        in the search box (after `prepare`): Σ r² per row is `objective` (default ``objective_``)
+        of those faults."""
+        monitor, duration = self.monitor_, self.duration_
+        fitness = self.objective_ if objective is None else objective
         keep = np.flatnonzero(fitness.weights > 0)
         root_w = np.sqrt(fitness.weights[keep])
-        reference = self.reference_.reference[keep]
+        reference = fitness.reference.reference[keep]
 
         def residuals(X: NDArray[np.float64]) -> NDArray[np.float64]:
             currents = monitor.simulate_many(search_to_faults(X), duration=duration, check=False)
@@ -736,6 +787,7 @@ def identify(
     generations: int | None = None,
     local_polish: bool = True,
     second_search: bool = True,
+    last_stage: str = "auto",
     slope_unit: str = "s",
     error_corner_hz: float | str | None = "auto",
     on_generation: OnGeneration | None = None,
@@ -760,6 +812,10 @@ def identify(
     `second_search` (with `local_polish`) searches again from another seed when the first fit is
     poorer than the monitor's usual (`SECOND_SEARCH_NRMSE`) and keeps the better;
     ``settings["second_search_run"]`` records it (`FaultIdentifier`).
+
+    `last_stage` ("auto", "switching", "none"; `FaultIdentifier`) corrects the monitor's bias
+    near the estimate by a switching model of the drive after the search ("auto": with the default
+    monitor); ``settings["switching_stage"]`` records it.
 
     `error_corner_hz` weights eq. (3) by the command's local frequency (`FaultIdentifier`): "auto"
     (default) as the monitor was measured to need, None for the paper's eq. 3 unweighted.
@@ -799,6 +855,7 @@ def identify(
         actuator, calibration=calibration, monitor=monitor
     )  # one that does not fit: now
     resolve_error_corner(error_corner_hz, monitor_model.monitor)  # a bad value: before the twin runs
+    resolve_last_stage(last_stage, monitor_model.monitor)
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -843,7 +900,7 @@ def identify(
         source = str(reference) if not isinstance(reference, SimResult) else "SimResult"
     ident = FaultIdentifier(
         optimizer, seed=opt_seed, pop_size=pop_size, generations=generations, local_polish=local_polish,
-        second_search=second_search, slope_unit=slope_unit, error_corner_hz=error_corner_hz, monitor=monitor_model, on_generation=on_generation,
+        second_search=second_search, last_stage=last_stage, slope_unit=slope_unit, error_corner_hz=error_corner_hz, monitor=monitor_model, on_generation=on_generation,
     )  # fmt: skip
     with numba_threads(workers):
         ident.fit(trace.t, trace.i_q, command, trace["theta_u"] if "theta_u" in trace.names else None)
@@ -881,7 +938,7 @@ def identify(
         uq_start = time.perf_counter()
         with numba_threads(workers):
             try:
-                interval = laplace(ident.objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
+                interval = laplace(ident.final_objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
                                    factors=factors)  # fmt: skip
             except InputError as exc:  # the estimate stands; only its intervals cannot be given
                 warnings.append(f"no intervals: {exc}; faults are detected by the point rule")
@@ -949,6 +1006,12 @@ def identify(
         # evaluations and whether it was taken (the lower fitness); None: not run. The history
         # and generations_run are the kept search's, the evaluations both searches'
         "second_search_run": ident.second_search_,
+        # the last stage run ("switching" or "none"; `switching`) and what the switching stage did:
+        # its steps, iterations, whether its estimate was taken, the switching model's eq. 3 at the
+        # search's estimate and after each iteration, its fit; None: not run (or the fit did not
+        # explain the measurement). The fitness and fit_nrmse are then the switching model's
+        "last_stage": ident.last_stage_,
+        "switching_stage": ident.switching_,
         # the fraction of samples the fitness compares (long holds of the command are left out)
         "samples_compared": round(ident.compared_, 4),
         # the fraction whose command is faster than the band the monitor was fitted on (left out)

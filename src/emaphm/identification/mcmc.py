@@ -77,7 +77,7 @@ def sample(
     temper = 2.0 * tau_r * s2
     if not (np.isfinite(temper) and temper > 0):
         raise InputError("the residual at the estimate is zero: no likelihood to sample")
-    monitor, duration, objective = ident.monitor_, ident.duration_, ident.objective_
+    monitor, duration, objective = ident.monitor_, ident.duration_, ident.final_objective_
     evaluations = [0]
 
     def log_prob(U: NDArray[np.float64]) -> NDArray[np.float64]:
