@@ -183,6 +183,8 @@ def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, 
     assert record["iterations"] == switching_module.SWITCHING_ITERATIONS and record["history"][0] > 0
     # the same search, then the stage: the switching model fits its estimate no worse than the search's
     assert record["fitness"] <= record["start_fitness"]
+    # and the search's own fitness is kept apart: the monitor's eq. 3 at the search's estimate
+    assert ident.search_fitness_ == plain.fitness_ == plain.search_fitness_
     # the fitness and fit NRMSE are the switching model's at the estimate, recomputed here
     current = SwitchingModel(EmaParams(), Chirp()).current(ident.faults_, duration=ident.duration_, workers=1)
     assert ident.fitness_ == pytest.approx(float(ident.objective_(current)), rel=1e-9)

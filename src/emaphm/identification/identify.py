@@ -446,8 +446,13 @@ class FaultIdentifier:
         self.fit_nrmse_, self.fitted_ = kept.fit_nrmse, kept.fitted
         # eq. 3 as the intervals see it: the monitor's, or the corrected monitor's after the last stage
         self.final_objective_ = fitness
+        # the search's own eq. 3 at its estimate (the monitor's): what tells one search's basin from
+        # another's; the switching model's eq. 3 cannot rank basins (its stick-slip is chaotic)
+        self.search_fitness_ = run.f
         # the last stage polishes too: none without the polish (a raw search stays raw)
-        self.last_stage_ = resolve_last_stage(self.last_stage, monitor.monitor) if self.local_polish else "none"
+        self.last_stage_ = (
+            resolve_last_stage(self.last_stage, monitor.monitor) if self.local_polish else "none"
+        )
         self.switching_: dict[str, Any] | None = None
         if self.last_stage_ == "switching" and explains(kept.fit_nrmse):
             x, more = self._switching_stage(recentre_phase(run).x)
@@ -1012,6 +1017,8 @@ def identify(
         # explain the measurement). The fitness and fit_nrmse are then the switching model's
         "last_stage": ident.last_stage_,
         "switching_stage": ident.switching_,
+        # the monitor's eq. 3 at the search's estimate (before the last stage; equal to fitness without one)
+        "search_fitness": ident.search_fitness_,
         # the fraction of samples the fitness compares (long holds of the command are left out)
         "samples_compared": round(ident.compared_, 4),
         # the fraction whose command is faster than the band the monitor was fitted on (left out)
