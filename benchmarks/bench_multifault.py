@@ -205,7 +205,7 @@ def main() -> None:
           f"p90 {100 * float(np.percentile(nrmses_switching, 90)):.2f} %, max {100 * max(nrmses_switching):.2f} %")  # fmt: skip
     print(f"%err over {n} runs: median {statistics.median(errs):.2f}, p90 {float(np.percentile(errs, 90)):.2f}, "
           f"max {max(errs):.2f}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
-    print(f"wrong basins (final fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
+    print(f"wrong basins (the search's fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
           f"runs whose estimate fits better than the truth (model bias): {bias_runs} of {n}")  # fmt: skip
     print(f"fit NRMSE over the compared samples: median {100 * statistics.median(fits):.2f} %, "
           f"p90 {100 * float(np.percentile(fits, 90)):.2f} %, max {100 * max(fits):.2f} %; "

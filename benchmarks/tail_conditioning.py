@@ -4,6 +4,7 @@
                                            [--psi 0.01] [--top 10]
     python benchmarks/tail_conditioning.py --standstill 300
     python benchmarks/tail_conditioning.py --step 2e-6
+    python benchmarks/tail_conditioning.py --switching
 
 The monitor's NRMSE at the true faults has a tail (monitor-model.md §4): a few actuators in a
 thousand reach 5-8 % where the median is under 2 %. This script asks whether those actuators are
@@ -30,7 +31,9 @@ switching state), which no averaged monitor carries.
 
 --step DT compares instead the twin run at another integration step DT (its default 1 µs) with
 itself: a *switching* monitor, the twin's own structure discretised differently, against the
-averaged one (issue 8's "multi-fidelity" option, monitor-model.md §5).
+averaged one (issue 8's "multi-fidelity" option, monitor-model.md §5). --switching compares the
+switching model the identification's last stage fits with (`switching.SwitchingModel`: the mean
+of the twin's runs at `switching.SWITCHING_STEPS`).
 """
 
 from __future__ import annotations
@@ -50,6 +53,7 @@ from emaphm.commands import Command
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.calibrate import CALIBRATION_COMMANDS
+from emaphm.identification.switching import SWITCHING_STEPS, SwitchingModel
 from emaphm.kernels.transforms import phase_directions
 from emaphm.models import HighFidelityEma, MonitorEma
 from emaphm.params import EmaParams
@@ -74,11 +78,14 @@ def main() -> None:
     parser.add_argument(
         "--step", type=float, default=0.0, help="DT [s]: the twin at step DT against itself instead"
     )
+    parser.add_argument(
+        "--switching", action="store_true", help="the last stage's switching model against the twin instead"
+    )
     args = parser.parse_args()
     if args.standstill:
         standstill(args)
         return
-    if args.step:
+    if args.step or args.switching:
         other_step(args)
         return
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
@@ -132,23 +139,22 @@ def _at_the_truth(
 def other_step(args: argparse.Namespace) -> None:
     """The twin at integration step `args.step` against the twin at its own, and the monitor beside it."""
     base = EmaParams()
+    steps = SWITCHING_STEPS if args.switching else (args.step,)
+    name = f"the switching model (mean of the twin at {', '.join(f'{s:g}' for s in steps)} s)"
     print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
           f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}), command {args.command}, "
-          f"HF noise off; the twin at {args.step:g} s against the twin at {base.integration.dt:g} s")  # fmt: skip
+          f"HF noise off; {name} against the twin at {base.integration.dt:g} s")  # fmt: skip
     start = time.perf_counter()
     cases, command, refs, lf = _at_the_truth(args, base)
-    other = HighFidelityEma(
-        dataclasses.replace(base, integration=dataclasses.replace(base.integration, dt=args.step)),
-        command=command,
-    )
+    other = SwitchingModel(base, command, steps)
     t0 = time.perf_counter()
     sw = 100 * np.array(
-        [ref.nrmse(other.simulate(k, noise=False).i_q) for ref, k in zip(refs, cases, strict=True)]
+        [ref.nrmse(other.current(k, duration=command.duration)) for ref, k in zip(refs, cases, strict=True)]
     )
     per_run = (time.perf_counter() - t0) / len(cases)
-    for label, v in (("monitor at the true faults", lf), (f"twin at {args.step:g} s", sw)):
+    for label, v in (("monitor at the true faults", lf), (name, sw)):
         print(f"  {label + ':':<36} {_stats(v)}   above 4 %: {int(np.sum(v > 4.0))}")
-    print(f"the twin at {args.step:g} s: {1e3 * per_run:.1f} ms per run, one thread")
+    print(f"{name}: {1e3 * per_run:.1f} ms per evaluation, one thread")
     print(f"{'case':>5} {'monitor':>8} {'step':>7}   faults k1..k8")
     for j in np.argsort(-lf)[: args.top]:
         print(f"{j:>5} {lf[j]:>7.2f}% {sw[j]:>6.2f}%   " + " ".join(f"{x:.2f}" for x in cases[j]))

@@ -277,6 +277,30 @@ def test_identify_from_a_reference_trace(tmp_path, capsys):
     assert code == 0 and data["truth"] is None and data["percent_error"] is None
 
 
+def test_identify_says_what_the_switching_last_stage_did(capsys, monkeypatch):
+    import json
+
+    from emaphm.identification import optimizers
+
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--uncertainty", "none", "--pop-size", "8",
+            "--generations", "2"]  # fmt: skip
+    code, stdout, _ = run_cli(args, capsys)
+    stdout = " ".join(stdout.split())  # the console wraps long lines
+    code_json, json_out, _ = run_cli([*args, "--json"], capsys)
+    data = json.loads(json_out)
+    stage = data["settings"]["switching_stage"]
+    assert code == code_json == 0 and data["settings"]["last_stage"] == "switching"
+    assert f"switching last stage: the switching model's eq. 3 {stage['start_fitness']:.4g}" in stdout
+    assert ("iterate" in stdout) == stage["taken"]
+    assert data["fitness"] == pytest.approx(stage["fitness"], rel=1e-6)
+    code, json_out, _ = run_cli([*args, "--json", "--last-stage", "none"], capsys)
+    settings = json.loads(json_out)["settings"]
+    assert code == 0 and settings["last_stage"] == "none" and settings["switching_stage"] is None
+    # the same search either way: the monitor's fitness at the search's estimate
+    assert settings["search_fitness"] == data["settings"]["search_fitness"]
+
+
 def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, monkeypatch):
     import json
 
@@ -340,6 +364,7 @@ def _write_bad_traces(d):
         (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--output", "r.txt"], "--output"),
         (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--error-corner", "-3"], "--error-corner"),
         (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--error-corner", "fast"], "--error-corner"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--last-stage", "fast"], "--last-stage"),
     ],
 )
 def test_identify_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, monkeypatch, args, reason):

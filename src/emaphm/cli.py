@@ -299,7 +299,7 @@ def _print_identification(data: dict[str, Any]) -> None:
         out.print(f"%err {data['percent_error']:.2f}")
     if data["fit_nrmse"] is not None:
         out.print(
-            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.4-3.9 %; "
+            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.3-3.9 %; "
             "above 6 % a warning, above 50 %: does not fit)"
         )
     second = data["settings"].get("second_search_run")
@@ -311,6 +311,20 @@ def _print_identification(data: dict[str, Any]) -> None:
             f"usual ({100 * second['trigger']:g} %); the second search's fitness "
             f"{'not finite' if ratio is None else f'{ratio:.3f} x the first'}: {kept}"
         )
+    stage = data["settings"].get("switching_stage")
+    if stage is not None:
+        if "error" in stage:
+            out.print(f"switching last stage: not run ({stage['error']}); the search's estimate stands")
+        else:
+            moved = (
+                f"the estimate of iterate {stage['iterate']} of {stage['iterations']} kept"
+                if stage["taken"]
+                else "the search's estimate fitted it best and stands"
+            )
+            out.print(
+                f"switching last stage: the switching model's eq. 3 {stage['start_fitness']:.4g} at the search's "
+                f"estimate, {stage['fitness']:.4g} at the final one ({moved}); the fit above is that model's"
+            )
     if data["verdict"] != "fits":
         out.print("verdict: does not fit (see the warning): no faults reported")
     else:

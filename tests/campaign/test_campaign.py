@@ -311,6 +311,26 @@ def test_a_campaign_sets_the_error_corner_as_identify_does(tmp_path):
         assert kwargs["error_corner_hz"] == passed and "error_corner" not in kwargs
 
 
+def test_a_campaign_sets_the_last_stage_as_identify_does(tmp_path):
+    """[identify] last_stage reaches `emaphm.identify`; an unknown stage is refused in one line."""
+    from emaphm.campaign.jobs import identify_kwargs
+
+    for given in ("auto", "switching", "none"):
+        (tmp_path / "c.toml").write_text(
+            f'[campaign]\nname = "x"\n[identify]\nlast_stage = "{given}"\n'
+            '[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n'
+        )
+        (job,) = load_campaign(tmp_path / "c.toml").jobs()
+        assert identify_kwargs(job.to_dict())["last_stage"] == given
+    for bad in ('"fast"', "true"):
+        (tmp_path / "c.toml").write_text(
+            f'[campaign]\nname = "x"\n[identify]\nlast_stage = {bad}\n'
+            '[[actuator]]\nid = "a"\nfaults = [0,0,0,0,0,0,0,0.5]\n'
+        )
+        with pytest.raises(InputError, match="last_stage"):
+            load_campaign(tmp_path / "c.toml")
+
+
 def test_a_campaign_can_turn_the_second_search_off_as_identify_does(tmp_path):
     """[identify] second_search reaches `emaphm.identify`; not a bool: refused in one line."""
     from emaphm.campaign.jobs import identify_kwargs

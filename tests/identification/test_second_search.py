@@ -109,7 +109,9 @@ def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
     )
     ran = {}
     for name in ("default", "paper"):
-        ident = FaultIdentifier(seed=7, last_stage="none", monitor=MonitorEma(monitor=name)).fit(trace.t, trace.i_q, Chirp())
+        ident = FaultIdentifier(seed=7, last_stage="none", monitor=MonitorEma(monitor=name)).fit(
+            trace.t, trace.i_q, Chirp()
+        )
         ran[name] = ident.second_search_
     assert ran["paper"] is None and ran["default"]["trigger"] == SECOND_SEARCH_NRMSE["default"]
 
@@ -125,7 +127,9 @@ def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monk
     assert res.settings["second_search"] is True and record is not None
     first_seed = res.settings["optimizer_seed"]
     alone = [
-        FaultIdentifier(seed=s, second_search=False, last_stage="none", **budget).fit(trace.t, trace.i_q, Chirp())
+        FaultIdentifier(seed=s, second_search=False, last_stage="none", **budget).fit(
+            trace.t, trace.i_q, Chirp()
+        )
         for s in (first_seed, second_seed(first_seed))
     ]
     assert alone[0].fit_nrmse_ > 0.01
@@ -136,7 +140,9 @@ def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monk
     np.testing.assert_allclose(res.estimate, best.faults_, atol=1e-6)
     assert res.evaluations == alone[0].run_.evaluations + alone[1].run_.evaluations
     assert res.settings["generations_run"] == len(best.run_.history)  # the kept search's
-    off = identify(reference=trace, seed=3, uncertainty="none", last_stage="none", second_search=False, **budget)
+    off = identify(
+        reference=trace, seed=3, uncertainty="none", last_stage="none", second_search=False, **budget
+    )
     assert (
         off.settings["second_search"] is False
         and off.settings["second_search_run"] is None

@@ -4,6 +4,7 @@ the discrepancy calibration, verdicts and the result's fields."""
 from __future__ import annotations
 
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -127,6 +128,12 @@ def test_the_phase_interval_wraps_through_zero_and_is_the_circle_when_undefined(
     k[5] = 0.003  # ζ within 2 σ of 0: the direction means nothing
     std_u, lo, hi, flags = intervals(k, std)
     assert (lo[6], hi[6]) == (0.0, 1.0) and "phase_undefined" in flags[6] and np.isnan(std_u[6])
+    # a direction no step could measure (σ infinite): the whole circle, quietly (no numpy warning)
+    k[5], std[6] = 0.2, np.inf
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        std_u, lo, hi, flags = intervals(k, std)
+    assert (lo[6], hi[6]) == (0.0, 1.0) and "phase_undefined" in flags[6]
 
 
 def test_verdicts_tell_present_absent_and_cannot_tell():
@@ -199,7 +206,13 @@ def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
     objective = LinearObjective(fit)
 
     class Ident:
-        faults_, monitor_, duration_, objective_, final_objective_ = truth, monitor, None, objective, objective
+        faults_, monitor_, duration_, objective_, final_objective_ = (
+            truth,
+            monitor,
+            None,
+            objective,
+            objective,
+        )
 
     local = laplace(fit, monitor, truth)  # type: ignore[arg-type]
     runs = [

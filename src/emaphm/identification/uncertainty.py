@@ -289,8 +289,9 @@ def intervals(
     lo, hi = np.clip(lo, 0.0, 1.0), np.clip(hi, 0.0, 1.0)
     undefined = ~(k[:, ZETA] >= PHASE_SIGMAS * s[:, ZETA]) | ~np.isfinite(s[:, PHASE]) | (k[:, ZETA] <= 0.0)
     whole = undefined | (Z90 * s[:, PHASE] >= 0.5)
-    lo[:, PHASE] = np.where(whole, 0.0, np.mod(k[:, PHASE] - Z90 * s[:, PHASE], 1.0))
-    hi[:, PHASE] = np.where(whole, 1.0, np.mod(k[:, PHASE] + Z90 * s[:, PHASE], 1.0))
+    with np.errstate(invalid="ignore"):  # a σ that is not finite: the whole circle, chosen below
+        lo[:, PHASE] = np.where(whole, 0.0, np.mod(k[:, PHASE] - Z90 * s[:, PHASE], 1.0))
+        hi[:, PHASE] = np.where(whole, 1.0, np.mod(k[:, PHASE] + Z90 * s[:, PHASE], 1.0))
     s[:, PHASE] = np.where(undefined, np.nan, s[:, PHASE])
     flags: list[list[str]] = []
     for row in range(k.shape[0] if with_flags else 0):
