@@ -186,7 +186,7 @@ def identify(
         str,
         typer.Option(
             help="With --polish, after the search: 'switching' corrects the monitor's bias near the estimate by the twin's "
-            "switching drive (about 1 s more), 'none' skips it, 'auto' (default) runs it with the default "
+            "switching drive (about 0.5 s more), 'none' skips it, 'auto' (default) runs it with the default "
             "monitor, not with --monitor paper (docs/identification.md)."
         ),
     ] = "auto",

@@ -187,11 +187,38 @@ def test_interval_calibration_files_round_trip_and_bad_ones_are_refused(tmp_path
 def test_the_packaged_calibration_belongs_to_the_packaged_monitor():
     from emaphm.calibration import default_calibration
 
-    packaged = load_factors()
-    assert packaged.matches(default_calibration("default"))
-    assert not packaged.matches(default_calibration("paper"))
-    train = packaged.record["training"]
-    assert all(0.85 <= v["coverage"] <= 0.97 for v in train.values())
+    for stage in ("switching", "none"):
+        packaged = load_factors(last_stage=stage)
+        assert packaged.matches(default_calibration("default"))
+        assert not packaged.matches(default_calibration("paper"))
+        train = packaged.record["training"]
+        assert all(0.85 <= v["coverage"] <= 0.97 for v in train.values())
+        assert packaged.record["last_stage"] == stage  # each made for its own last stage
+    assert load_factors() is load_factors(last_stage="switching")  # the default identification's
+    # the switching stage's estimates are closer to the truth: its intervals are the narrower
+    narrow, wide = (
+        load_factors(last_stage="switching").record["training"],
+        load_factors(last_stage="none").record["training"],
+    )
+    assert all(narrow[f]["median_half_width"] < wide[f]["median_half_width"] for f in narrow)
+    with pytest.raises(InputError, match="last stage"):
+        load_factors(last_stage="auto")
+
+
+def test_identify_takes_the_interval_calibration_of_its_last_stage_and_warns_on_another(monkeypatch):
+    from emaphm.identification import optimizers
+    from emaphm.identification.identify import identify
+
+    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    small = {"pop_size": 8, "generations": 2, "seed": 1}
+    k = [0.2, 0, 0, 0, 0, 0, 0, 0.5]
+    for stage in ("switching", "none"):
+        res = identify(k, last_stage=stage, **small)
+        assert res.settings["uq_calibration"]["created"] == load_factors(last_stage=stage).record["created"]
+        assert not any("last stage" in w for w in res.warnings)
+    # a calibration made with the stage, given to an identification without it: said so
+    res = identify(k, last_stage="none", uq_calibration=load_factors(last_stage="switching"), **small)
+    assert any("fitted on identifications with the last stage 'switching'" in w for w in res.warnings)
 
 
 def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():

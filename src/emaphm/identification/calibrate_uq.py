@@ -90,6 +90,7 @@ def calibrate_uq(
     `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
     """
     from .identify import resolve_error_corner
+    from .switching import resolve_last_stage
 
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
@@ -111,6 +112,9 @@ def calibrate_uq(
         },
         # the eq. 3 frequency weights the identifications used (`fitness.error_weights`)
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),
+        # the last stage the identifications ran (`switching`): it sets how far estimates fall
+        # from the truth, so intervals fitted with one do not hold for the other
+        "last_stage": resolve_last_stage("auto", lf.monitor),
         "cases": cases,
         "seed": seed,
         "absent": UQ_ABSENT,

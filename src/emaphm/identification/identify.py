@@ -247,7 +247,7 @@ class FaultIdentifier:
         Time unit of the slope in the eq. (3) weights.
     last_stage : {"auto", "switching", "none"}
         "switching" (with `local_polish`): after the search, correct the monitor's bias near the estimate by the twin's
-        switching drive at other integration steps (`switching.space_mapping`, ≈ 1 s more);
+        switching drive at other integration steps (`switching.space_mapping`, ≈ 0.4–0.7 s more);
         the fitness and fit NRMSE are then the switching model's at the estimate, and
         `switching_` records the stage. "auto": the switching stage with the default monitor,
         none with the paper's.
@@ -851,18 +851,19 @@ def identify(
         from .mcmc import check_emcee
 
         check_emcee()
+    monitor_model = MonitorEma(
+        actuator, calibration=calibration, monitor=monitor
+    )  # one that does not fit: now
+    resolve_error_corner(error_corner_hz, monitor_model.monitor)  # a bad value: before the twin runs
+    # the last stage that will run (none without the polish), and the interval calibration made for it
+    stage = resolve_last_stage(last_stage, monitor_model.monitor) if local_polish else "none"
     factors = (
         None
         if uncertainty == "none"
         else uq_calibration
         if isinstance(uq_calibration, Factors)
-        else load_factors(uq_calibration)
+        else load_factors(uq_calibration, last_stage=stage)
     )
-    monitor_model = MonitorEma(
-        actuator, calibration=calibration, monitor=monitor
-    )  # one that does not fit: now
-    resolve_error_corner(error_corner_hz, monitor_model.monitor)  # a bad value: before the twin runs
-    resolve_last_stage(last_stage, monitor_model.monitor)
     start = time.perf_counter()
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
@@ -942,6 +943,12 @@ def identify(
                 "intervals show the measurement noise only, not the model's bias (run 'emaphm calibrate-uq')"
             )
             factors = Factors.identity()
+        elif factors.record and factors.record.get("last_stage", "none") != ident.last_stage_:
+            warnings.append(
+                f"the interval calibration was fitted on identifications with the last stage "
+                f"{factors.record.get('last_stage', 'none')!r}, this one ran {ident.last_stage_!r}: its intervals "
+                "may not hold (run 'emaphm calibrate-uq' with the same settings)"
+            )
         uq_start = time.perf_counter()
         with numba_threads(workers):
             try:

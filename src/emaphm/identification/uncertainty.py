@@ -186,15 +186,25 @@ class Factors:
         )
 
 
-@functools.lru_cache(maxsize=1)
-def _packaged() -> Factors:
-    return Factors.from_json(read_package_json("uq_calibration.json"), "emaphm/data/uq_calibration.json")
+# the packaged interval calibrations, by the identification's last stage (`switching.LAST_STAGES`):
+# the switching stage leaves estimates about half as far from the truth, so its intervals are
+# narrower; the other file was fitted without it (both with the packaged LF calibration)
+PACKAGED_FACTORS = {"switching": "uq_calibration.json", "none": "uq_calibration_no_last_stage.json"}
 
 
-def load_factors(path: str | os.PathLike[str] | None = None) -> Factors:
-    """The interval calibration: the packaged one, or a file from ``emaphm calibrate-uq``."""
+@functools.lru_cache(maxsize=2)
+def _packaged(last_stage: str) -> Factors:
+    name = PACKAGED_FACTORS[last_stage]
+    return Factors.from_json(read_package_json(name), f"emaphm/data/{name}")
+
+
+def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str = "switching") -> Factors:
+    """The interval calibration: a file from ``emaphm calibrate-uq``, or the packaged one for
+    identifications with that last stage ("switching" or "none", `PACKAGED_FACTORS`)."""
     if path is None:
-        return _packaged()
+        if last_stage not in PACKAGED_FACTORS:
+            raise InputError(f"no packaged interval calibration for the last stage {last_stage!r}")
+        return _packaged(last_stage)
     p = Path(path)
     try:
         data = json.loads(p.read_text())
