@@ -78,6 +78,12 @@ def test_a_report_shows_the_verdict_faults_and_figures_and_needs_nothing_else(me
         and "rig.toml" in text
         and "71.3" in text
     )
+    # the fit's caption names the model whose current it shows: the LF model without a last stage,
+    # the switching model after one (`FaultIdentifier.curves`)
+    assert "the LF model at the identified faults" in text
+    staged = dataclasses.replace(result, settings={**result.settings, "switching_stage": {"taken": True}})
+    text = " ".join(_read(write_report(staged, tmp_path / "rep3")).text)
+    assert "the switching model at the identified faults" in text and "LF model at" not in text
 
 
 def test_a_recording_the_model_cannot_explain_reports_no_fault(measured, tmp_path):

@@ -79,19 +79,23 @@ def plot_fit(
 
 
 def plot_fit_curves(
-    curves: Mapping[str, np.ndarray], path: Path, title: str = "", raw: np.ndarray | None = None
+    curves: Mapping[str, np.ndarray],
+    path: Path,
+    title: str = "",
+    raw: np.ndarray | None = None,
+    model: str = "LF model",
 ) -> Path:
-    """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the LF
-    current at the estimate and their residual; samples the fitness left out (a rest in a hold,
-    motion faster than the monitor was fitted on) shaded, and
-    the unfiltered measurement `raw` behind when given."""
+    """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the
+    `model`'s current at the estimate (the LF model's, or the switching model's after the last
+    stage) and their residual; samples the fitness left out (a rest in a hold, motion faster than
+    the monitor was fitted on) shaded, and the unfiltered measurement `raw` behind when given."""
     plt = _pyplot()
     t, m, f = curves["t"], curves["measured"], curves["fitted"]
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
     if raw is not None:
         ax[0].plot(t, raw, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
     ax[0].plot(t, m, "k", lw=1.0, label="measured $i_q$, filtered")
-    ax[0].plot(t, f, "C1", lw=1.0, label="LF model at the identified faults")
+    ax[0].plot(t, f, "C1", lw=1.0, label=f"{model} at the identified faults")
     ax[0].set_ylabel("current [A]")
     ax[0].legend(loc="upper right", fontsize=8)
     ax[1].plot(t, m - f, "C3", lw=0.8)

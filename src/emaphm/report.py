@@ -62,7 +62,7 @@ def write_report(
         if result.curves is not None:
             nrmse = data["fit_nrmse"]
             title = f"fit NRMSE {100 * nrmse:.2f} % of the filtered current" if nrmse is not None else ""
-            plot_fit_curves(result.curves, tmp / "fit.png", title)
+            plot_fit_curves(result.curves, tmp / "fit.png", title, model=_fit_model(data))
         bounds = (
             {"estimate": (np.asarray(data["ci90_low"]), np.asarray(data["ci90_high"]))}
             if data["ci90_low"] is not None
@@ -151,7 +151,7 @@ def _page(data: dict[str, Any], figures: dict[str, bytes], provenance: dict[str,
         parts.append("</ul></div>")
     parts += ["<h2>Faults</h2>", "".join(table)]
     captions = {
-        "fit.png": "Measured current (filtered) and the LF model at the identified faults, with the residual",
+        "fit.png": f"Measured current (filtered) and the {_fit_model(data)} at the identified faults, with the residual",
         "faults.png": "Identified faults with their 90 % intervals",
         "convergence.png": "Best fitness per generation (global search, then polish)",
     }
@@ -170,3 +170,10 @@ def _page(data: dict[str, Any], figures: dict[str, bytes], provenance: dict[str,
         "</body></html>",
     ]
     return "\n".join(parts) + "\n"
+
+
+def _fit_model(data: dict[str, Any]) -> str:
+    """Which model's current the fit shows: the switching model's after a switching last stage
+    that ran (`FaultIdentifier.curves`), else the LF monitor's."""
+    stage = data["settings"].get("switching_stage")
+    return "switching model" if stage is not None and "error" not in stage else "LF model"

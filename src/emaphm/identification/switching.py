@@ -2,10 +2,12 @@
 
 The averaged monitor errs at the truth like a twin with a 1 % torque error (LF-vs-HF NRMSE median
 1.8 %, 7 in 1000 random cases above 4 %; docs/theory/monitor-model.md §4), and that bias, not the
-search, makes most of an estimate's error. A switching model, the twin's hysteresis drive at
-other integration steps, follows the twin to 1.2 % median and 3.4 % at worst, but it costs ≈ 30
-monitor runs per run: a search on it does not fit the time budget. So the search stays on the
-monitor and this stage corrects it where the estimate is, by output space mapping:
+search, makes most of an estimate's error. A switching model, the mean of the twin's hysteresis
+drive at three other integration steps, follows the twin to 1.05 % median and 2.74 % at worst
+over 1000 random cases (`benchmarks/tail_conditioning.py --switching`), but one evaluation costs
+≈ 50 ms of one thread, ~100 monitor runs: a search on it does not fit the time budget. So the
+search stays on the monitor and this stage corrects it where the estimate is, by output space
+mapping:
 
     d_j = F(I_S(k_j)) − F(I_LF(k_j)),   d̄_j = (d_1 + … + d_j) / j,
     k_(j+1) = argmin_k  Σ w · (I_ref − F(I_LF(k)) − d̄_j)²    (eq. 3 of the corrected monitor)
@@ -14,7 +16,8 @@ with F the comparison filter, I_S the switching model's current (`SwitchingModel
 runs at `SWITCHING_STEPS`), w eq. 3's weights and each argmin a least-squares polish of the
 monitor from k_j (`optimizers.least_squares_polish`). d is the monitor's error near the estimate;
 where it changes slowly with k, the fixed point is where the switching model fits the measurement
-with the monitor's sensitivities. Averaging d over the iterations (and I_S over the steps) keeps
+with the monitor's sensitivities (where those mislead, the fixed point is elsewhere: docs/
+identification.md §6). Averaging d over the iterations (and I_S over the steps) keeps
 the chaotic stick–slip realisation of any one run out of the correction: a polish on one
 discretisation's current fitted that realisation instead of the faults (BENCHMARKS.md, "A
 switching last stage, measured and not built").
