@@ -445,6 +445,7 @@ class FaultIdentifier:
         self.least_squares_gain_ = kept.least_squares_gain
         x, self.fitness_ = run.x, run.f
         # how well the best LF current explains the compared samples (both filtered), for the verdict
+        # (after the switching last stage, the switching model's current at its estimate)
         self.fit_nrmse_, self.fitted_ = kept.fit_nrmse, kept.fitted
         # eq. 3 as the intervals see it: the monitor's, or the corrected monitor's after the last stage
         self.final_objective_ = fitness
@@ -559,7 +560,8 @@ class FaultIdentifier:
 
     def curves(self) -> dict[str, NDArray[np.float64]]:
         """The fit as curves on the model grid over the whole recording: ``t`` [s], the filtered
-        ``measured`` current and the ``fitted`` LF current at the estimate [A] (NaN if its run
+        ``measured`` current and the ``fitted`` model current at the estimate [A] (the LF
+        monitor's, or the switching model's after the last stage; NaN if its run
         diverged, and after the span the search simulated, `duration_`), and ``compared``, the
         weight each sample had in the fitness (0 where left out: a rest in a hold, motion above
         the band)."""
