@@ -15,9 +15,14 @@ other than the first may run beside BLAS's own pool, slower.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from typing import TypeVar
 
 from .errors import InputError
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 @contextlib.contextmanager
@@ -37,3 +42,13 @@ def numba_threads(workers: int | None, *, name: str = "workers") -> Iterator[Non
             yield
     finally:
         numba.set_num_threads(previous)
+
+
+def thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:
+    """`fn` of each item, in order, side by side on up to `workers` Python threads (serially on
+    one): for compiled kernels that release the GIL (`HighFidelityEma.simulate_batch`)."""
+    threads = max(1, min(workers, len(items)))
+    if threads == 1:
+        return [fn(item) for item in items]
+    with ThreadPoolExecutor(threads) as pool:
+        return list(pool.map(fn, items))

@@ -150,6 +150,7 @@ def test_the_last_stage_setting():
     assert resolve_last_stage("auto", "paper") == "none"  # the paper's method as published
     assert resolve_last_stage("switching", "paper") == "switching"
     assert resolve_last_stage("none", "default") == "none"
+    assert resolve_last_stage("switching", "default", local_polish=False) == "none"  # a raw search
     with pytest.raises(InputError, match="last stage"):
         resolve_last_stage("fast", "default")
     with pytest.raises(InputError, match="last stage"):

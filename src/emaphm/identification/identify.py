@@ -58,7 +58,7 @@ from .optimizers import (
     run_optimizer,
 )
 from .signals import Comparison, nrmse
-from .switching import LAST_STAGES, SwitchingModel, resolve_last_stage, space_mapping
+from .switching import SwitchingModel, check_last_stage, resolve_last_stage, space_mapping
 from .uncertainty import UQ_METHODS, Factors, Uncertainty, laplace, load_factors, verdicts
 
 __all__ = [
@@ -279,8 +279,7 @@ class FaultIdentifier:
         monitor: MonitorEma | None = None,
         on_generation: OnGeneration | None = None,
     ) -> None:
-        if last_stage not in LAST_STAGES:
-            raise InputError(f"unknown last stage {last_stage!r}; use one of {', '.join(LAST_STAGES)}")
+        check_last_stage(last_stage)
         self.optimizer = optimizer
         self.seed = seed
         self.pop_size = pop_size
@@ -452,9 +451,8 @@ class FaultIdentifier:
         # the search's own eq. 3 at its estimate (the monitor's): what tells one search's basin from
         # another's; the switching model's eq. 3 cannot rank basins (its stick-slip is chaotic)
         self.search_fitness_ = run.f
-        # the last stage polishes too: none without the polish (a raw search stays raw)
-        self.last_stage_ = (
-            resolve_last_stage(self.last_stage, monitor.monitor) if self.local_polish else "none"
+        self.last_stage_ = resolve_last_stage(
+            self.last_stage, monitor.monitor, local_polish=self.local_polish
         )
         self.switching_: dict[str, Any] | None = None
         if self.last_stage_ == "switching" and explains(kept.fit_nrmse):
@@ -858,7 +856,7 @@ def identify(
     )  # one that does not fit: now
     resolve_error_corner(error_corner_hz, monitor_model.monitor)  # a bad value: before the twin runs
     # the last stage that will run (none without the polish), and the interval calibration made for it
-    stage = resolve_last_stage(last_stage, monitor_model.monitor) if local_polish else "none"
+    stage = resolve_last_stage(last_stage, monitor_model.monitor, local_polish=local_polish)
     factors = (
         None
         if uncertainty == "none"

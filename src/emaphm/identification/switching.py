@@ -32,13 +32,13 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._threads import thread_map
 from ..commands import Command
 from ..errors import InputError, SimulationError
 from ..models import HighFidelityEma
@@ -53,6 +53,7 @@ __all__ = [
     "SWITCHING_STEPS",
     "SwitchingModel",
     "SwitchingStage",
+    "check_last_stage",
     "resolve_last_stage",
     "space_mapping",
 ]
@@ -67,11 +68,20 @@ SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)
 SWITCHING_ITERATIONS = 3
 
 
-def resolve_last_stage(value: str, monitor: str) -> str:
-    """The last stage an identification runs ("switching" or "none") for a `LAST_STAGES` setting;
-    "auto" gives the switching stage with the default monitor, none with the paper's."""
+def check_last_stage(value: str) -> str:
+    """`value` if it is one of `LAST_STAGES`, else `InputError`."""
     if value not in LAST_STAGES:
         raise InputError(f"unknown last stage {value!r}; use one of {', '.join(LAST_STAGES)}")
+    return value
+
+
+def resolve_last_stage(value: str, monitor: str, *, local_polish: bool = True) -> str:
+    """The last stage an identification runs ("switching" or "none") for a `LAST_STAGES` setting;
+    "auto" gives the switching stage with the default monitor, none with the paper's. Without the
+    polish none runs: a raw search stays raw."""
+    check_last_stage(value)
+    if not local_polish:
+        return "none"
     if value == "auto":
         return "switching" if monitor == "default" else "none"
     return value
@@ -101,13 +111,7 @@ class SwitchingModel:
         def run(model: HighFidelityEma) -> NDArray[np.float64]:
             return model.simulate(k, noise=False, duration=duration).i_q
 
-        threads = max(1, min(workers, len(self.models)))
-        if threads == 1:
-            runs = [run(m) for m in self.models]
-        else:
-            with ThreadPoolExecutor(threads) as pool:
-                runs = list(pool.map(run, self.models))
-        return np.mean(runs, axis=0)  # type: ignore[no-any-return]
+        return np.mean(thread_map(run, self.models, workers), axis=0)  # type: ignore[no-any-return]
 
 
 @dataclass

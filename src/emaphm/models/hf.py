@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._threads import thread_map
 from ..errors import InputError
 from ..faults import HEALTHY, FaultedParameters, apply_faults, as_fault_matrix, as_fault_vector
 from ..kernels.hf_twin import N_OUT, OUT_COLUMNS, simulate_hf
@@ -89,15 +89,11 @@ class HighFidelityEma(_EmaModel):
             raise InputError(f"seeds has {len(seeds)} values for {len(rows)} fault rows")
         if workers is not None and workers < 0:
             raise InputError(f"workers must be 0 or more, got {workers}")
-        threads = min(workers or numba.get_num_threads(), len(rows)) or 1
-        if threads == 1:
-            return [
-                self.simulate(k, noise=noise, seed=s, duration=duration)
-                for k, s in zip(rows, seeds, strict=True)
-            ]
-        with ThreadPoolExecutor(threads) as pool:
-            return list(pool.map(lambda ks: self.simulate(ks[0], noise=noise, seed=ks[1], duration=duration),
-                                 zip(rows, seeds, strict=True)))  # fmt: skip
+        return thread_map(
+            lambda ks: self.simulate(ks[0], noise=noise, seed=ks[1], duration=duration),
+            list(zip(rows, seeds, strict=True)),
+            workers or numba.get_num_threads(),
+        )
 
     def simulate(
         self,
