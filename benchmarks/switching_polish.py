@@ -64,17 +64,14 @@ def main() -> None:
           + (f", {args.budget} evaluations" if args.method == "cma" else ""))  # fmt: skip
     command = CALIBRATION_COMMANDS[args.command]
     base = EmaParams()
-    switching = [
-        HighFidelityEma(
-            dataclasses.replace(
-                base,
-                integration=dataclasses.replace(base.integration, dt=float(step)),
-                motor=dataclasses.replace(base.motor, psi_m=base.motor.psi_m * (1.0 + args.psi)),
-            ),
-            command=command,
-        )
-        for step in args.step.split(",")
-    ]
+    # the switching model: the twin at each step (ψ_m off by --psi), its current the runs' mean
+    model = SwitchingModel(
+        dataclasses.replace(
+            base, motor=dataclasses.replace(base.motor, psi_m=base.motor.psi_m * (1.0 + args.psi))
+        ),
+        command,
+        [float(s) for s in args.step.split(",")],
+    )
     twin = HighFidelityEma(base, command=command)
     before, after = [], []
     for j, k in enumerate(random_faults(args.cases, args.case_seed)):
@@ -85,15 +82,13 @@ def main() -> None:
         x0, eq3, span = np.array(ident.faults_), ident.objective_, ident.duration_
         if args.method == "space-mapping":
             start = time.perf_counter()
-            # the switching models above (their steps, their ψ_m), as the package's stage runs them
-            model = SwitchingModel(switching[0].params, command, [float(s) for s in args.step.split(",")])
-            monitor_ = ident.monitor_
+            monitor_ = ident.monitor_  # the stage as the package runs it, with the switching model above
 
             def lf(k: np.ndarray, m=monitor_, d=span) -> np.ndarray:  # type: ignore[no-untyped-def]
                 return m.simulate(k, duration=d).i_q
 
-            def hf(k: np.ndarray, m=model, d=span) -> np.ndarray:  # type: ignore[no-untyped-def]
-                return m.current(k, duration=d, workers=2)
+            def hf(k: np.ndarray, d=span) -> np.ndarray:  # type: ignore[no-untyped-def]
+                return model.current(k, duration=d, workers=2)
 
             stage = space_mapping(
                 eq3, ident.residuals, lf, hf, search_to_faults, recentre_phase(ident.run_).x
@@ -108,9 +103,7 @@ def main() -> None:
 
         def f(X: np.ndarray, eq3=eq3, span=span) -> np.ndarray:  # type: ignore[no-untyped-def]
             X = np.clip(np.atleast_2d(X), 0.0, 1.0)
-            runs = [
-                np.mean([m.simulate(x, noise=False, duration=span).i_q for m in switching], axis=0) for x in X
-            ]
+            runs = [model.current(x, duration=span) for x in X]
             return np.asarray(eq3(np.array(runs)), dtype=np.float64)
 
         start = time.perf_counter()
