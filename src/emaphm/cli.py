@@ -21,6 +21,7 @@ import typer
 from rich.console import Console
 
 from ._threads import numba_threads
+from .choices import COMMAND_NAMES, HEALTHY_TEXT, LAST_STAGES, UQ_METHODS
 from ._version import __version__
 from .errors import InputError, SimulationError
 
@@ -41,11 +42,6 @@ app = typer.Typer(
 )
 err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
 
-# literals, so that the CLI starts without numpy (tests/test_cli.py checks them against the code)
-HEALTHY_TEXT = "0,0,0,0,0,0,0,0.5"  # emaphm.faults.HEALTHY
-COMMAND_NAMES = ("chirp", "chirp-hold", "steps", "step", "ramp", "sine")  # emaphm.commands.COMMANDS
-UQ_METHOD_NAMES = ("none", "laplace", "mcmc")  # emaphm.identification.uncertainty.UQ_METHODS
-LAST_STAGE_NAMES = ("auto", "switching", "none")  # emaphm.identification.switching.LAST_STAGES
 
 
 def _status(message: str) -> Any:
@@ -206,13 +202,13 @@ def identify(
 
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of --true-faults or --reference")
-    if uncertainty not in UQ_METHOD_NAMES:
-        raise InputError(f"unknown --uncertainty {uncertainty!r}; use one of {', '.join(UQ_METHOD_NAMES)}")
+    if uncertainty not in UQ_METHODS:
+        raise InputError(f"unknown --uncertainty {uncertainty!r}; use one of {', '.join(UQ_METHODS)}")
     check_optimizer(optimizer)  # before the reference is parsed, so the reason is the optimiser
     check_seed(seed)
     corner = _error_corner(error_corner)
-    if last_stage not in LAST_STAGE_NAMES:
-        raise InputError(f"unknown --last-stage {last_stage!r}; use one of {', '.join(LAST_STAGE_NAMES)}")
+    if last_stage not in LAST_STAGES:
+        raise InputError(f"unknown --last-stage {last_stage!r}; use one of {', '.join(LAST_STAGES)}")
     truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
     if reference is not None and map_file is None:
         check_trace_path(reference, for_writing=False)

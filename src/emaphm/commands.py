@@ -17,6 +17,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .choices import COMMAND_NAMES
 from .errors import InputError
 
 __all__ = [
@@ -223,9 +224,9 @@ def command_record(command: Command) -> dict[str, Any]:
     return {"type": name, **{k: list(v) if isinstance(v, tuple) else v for k, v in vars(command).items()}}
 
 
-COMMANDS: dict[str, type] = {
-    "chirp": Chirp, "chirp-hold": ChirpHold, "steps": Steps, "step": Step, "ramp": Ramp, "sine": Sine,
-}  # fmt: skip
+COMMANDS: dict[str, type] = dict(
+    zip(COMMAND_NAMES, (Chirp, ChirpHold, Steps, Step, Ramp, Sine), strict=True)
+)  # the names: `choices.COMMAND_NAMES`
 
 
 def make_command(name: str, **settings: Any) -> Command:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .choices import HEALTHY_TEXT
 from .errors import InputError
 from .params import EmaParams
 
@@ -62,7 +63,7 @@ FAULT_DESCRIPTIONS: tuple[str, ...] = (
     "static eccentricity phase, φ_e = 2π·k7",
     "proportional-gain drift, K_P = K_P0·(0.5 + k8)",
 )
-HEALTHY: NDArray[np.float64] = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5])
+HEALTHY: NDArray[np.float64] = np.array([float(v) for v in HEALTHY_TEXT.split(",")])
 HEALTHY.setflags(write=False)
 TABLE1_REFERENCE: NDArray[np.float64] = np.array(
     [0.2383, 0.5003, 5.32e-7, 0.4503, 0.0404, 0.0028, 0.2785, 0.5]

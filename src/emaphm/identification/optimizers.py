@@ -40,6 +40,7 @@ from pymoo.termination.ftol import SingleObjectiveSpaceTermination
 from pymoo.termination.max_gen import MaximumGenerationTermination
 from pymoo.termination.robust import RobustTermination
 
+from ..choices import OPTIMIZERS
 from ..errors import InputError
 
 __all__ = [
@@ -66,7 +67,6 @@ Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 Residuals = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 OnGeneration = Callable[[int, int, float], None]  # (generation, max generations, best value)
 
-OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo")
 # (population, max generations) of the global search, ≈ 3840 evaluations for every optimiser
 # (CMA-ES: 1 + 64 × 59, its first generation is the start point; GWO: 64 × 61, its initial pack is
 # evaluated before the first generation). The GA gets a wider, shorter run: at 64 x 60 it ended in

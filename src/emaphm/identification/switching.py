@@ -39,6 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._threads import thread_map
+from ..choices import LAST_STAGES
 from ..commands import Command
 from ..errors import InputError, SimulationError
 from ..models import HighFidelityEma
@@ -58,9 +59,6 @@ __all__ = [
     "space_mapping",
 ]
 
-# the identification's last stage: "switching" (this module), "none", or "auto": the switching
-# stage with the default monitor, none with the paper's (whose method is reproduced as published)
-LAST_STAGES = ("auto", "switching", "none")
 # the switching model's integration steps [s]: the twin's drive at steps other than its own 1 µs,
 # each a whole fraction of the 100 µs sample period (`EmaParams`); its current is their runs' mean
 SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)

@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._data import read_package_json
+from ..choices import UQ_METHODS
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY
 
@@ -64,7 +65,6 @@ __all__ = [
     "verdicts",
 ]
 
-UQ_METHODS = ("none", "laplace", "mcmc")
 UQ_FORMAT = "emaphm-uq-calibration"
 UQ_FORMAT_VERSION = 1
 
