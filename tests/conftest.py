@@ -38,10 +38,10 @@ def sim():
 def small_polish(monkeypatch):
     """A CMA-ES polish of 16 x 50 instead of the shipped 32 x 50: half the cost of an
     identification, same accuracy on the test cases (measured; see the tests that use it)."""
-    from emaphm.identification import optimizers
+    from emaphm.identification import limits
 
     budget = (16, 50)
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", budget)
+    monkeypatch.setattr(limits, "POLISH_BUDGET", budget)
     return budget
 
 

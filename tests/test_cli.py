@@ -81,7 +81,7 @@ def test_demo_runs_and_writes_its_figures(tmp_path):
     from emaphm.demo import run_demo
 
     console = Console(record=True, width=160)
-    budget = {"pop_size": 16, "generations": 3, "local_polish": False}  # the table, not convergence
+    budget = {"pop_size": 16, "generations": 3, "polish": False}  # the table, not convergence
     data = run_demo(tmp_path / "demo", runs=2, console=console, budget=budget)
     for name in ("hf_table1.png", "identified_current.png", "convergence.png", "identified_vs_true.png"):
         assert (tmp_path / "demo" / name).stat().st_size > 10_000
@@ -111,12 +111,12 @@ def test_the_choice_lists_are_the_codes_own():
     # one list each (emaphm.choices, numpy-free for the CLI): the code's names are the same objects
     from emaphm import HEALTHY, choices
     from emaphm.commands import COMMANDS
-    from emaphm.identification import optimizers, switching, uncertainty
+    from emaphm.identification import last_stage, optimizers, uncertainty
 
     assert [float(v) for v in choices.HEALTHY_TEXT.split(",")] == list(HEALTHY)
     assert tuple(COMMANDS) == choices.COMMAND_NAMES
     assert uncertainty.UQ_METHODS is choices.UQ_METHODS
-    assert switching.LAST_STAGES is choices.LAST_STAGES
+    assert last_stage.LAST_STAGES is choices.LAST_STAGES
     assert optimizers.OPTIMIZERS is choices.OPTIMIZERS
 
 
@@ -279,23 +279,24 @@ def test_identify_from_a_reference_trace(tmp_path, capsys):
 def test_identify_says_what_the_switching_last_stage_did(capsys, monkeypatch):
     import json
 
-    from emaphm.identification import optimizers
+    from emaphm.identification import limits
+    from emaphm.identification.result import stage_record
 
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
     args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--uncertainty", "none", "--pop-size", "8",
             "--generations", "2"]  # fmt: skip
     code, stdout, _ = run_cli(args, capsys)
     stdout = " ".join(stdout.split())  # the console wraps long lines
     code_json, json_out, _ = run_cli([*args, "--json"], capsys)
     data = json.loads(json_out)
-    stage = data["settings"]["switching_stage"]
+    stage = stage_record(data["settings"], "last_stage")["switching"]
     assert code == code_json == 0 and data["settings"]["last_stage"] == "switching"
     assert f"switching last stage: the switching model's eq. 3 {stage['start_fitness']:.4g}" in stdout
     assert ("iterate" in stdout) == stage["taken"]
     assert data["fitness"] == pytest.approx(stage["fitness"], rel=1e-6)
     code, json_out, _ = run_cli([*args, "--json", "--last-stage", "none"], capsys)
     settings = json.loads(json_out)["settings"]
-    assert code == 0 and settings["last_stage"] == "none" and settings["switching_stage"] is None
+    assert code == 0 and settings["last_stage"] == "none" and stage_record(settings, "last_stage")["switching"] is None
     # the same search either way: the monitor's fitness at the search's estimate
     assert settings["search_fitness"] == data["settings"]["search_fitness"]
 
@@ -303,32 +304,32 @@ def test_identify_says_what_the_switching_last_stage_did(capsys, monkeypatch):
 def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, monkeypatch):
     import json
 
-    from emaphm.identification import identify as identify_module
-    from emaphm.identification import optimizers
+    from emaphm.identification import limits
+    from emaphm.identification.result import stage_record
 
     # a trigger every fit exceeds, a tiny polish: the second search runs, and the output says so
-    monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.0)
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setitem(limits.SECOND_SEARCH_NRMSE, "default", 0.0)
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
     args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--uncertainty", "none", "--pop-size", "8",
             "--generations", "2"]  # fmt: skip
     code, stdout, _ = run_cli(args, capsys)
     stdout = " ".join(stdout.split())  # the console wraps long lines
     assert code == 0 and "second search: the first fit's NRMSE " in stdout and "x the first: " in stdout
     code, json_out, _ = run_cli([*args, "--json"], capsys)
-    record = json.loads(json_out)["settings"]["second_search_run"]
+    record = stage_record(json.loads(json_out)["settings"], "second_search")
     assert code == 0 and record["trigger"] == 0.0 and record["first_fit_nrmse"] > 0.0
     # the line says which result was kept, as the record does
     kept = "its result kept" if record["taken"] else "the first search's result kept"
     assert kept in stdout
     code, stdout, _ = run_cli([*args, "--json", "--no-second-search"], capsys)
     data = json.loads(stdout)
-    assert data["settings"]["second_search"] is False and data["settings"]["second_search_run"] is None
+    assert stage_record(data["settings"], "second_search") == {"stage": "second_search", "enabled": False, "ran": False}
     code, stdout, _ = run_cli([*args, "--no-second-search"], capsys)
     assert "second search" not in stdout
 
 
 def test_the_second_search_help_gives_the_triggers_the_code_uses(capsys):
-    from emaphm.identification.identify import SECOND_SEARCH_NRMSE
+    from emaphm.identification.limits import SECOND_SEARCH_NRMSE
 
     code, stdout, _ = run_cli(["identify", "--help"], capsys)
     text = " ".join(stdout.replace("│", " ").split())

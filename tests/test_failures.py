@@ -192,7 +192,7 @@ def test_a_3khz_trace_of_one_second_is_identified():
             "i_q": np.interp(t, measured.t, measured.i_q),
         },
     )
-    r = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=2, local_polish=False)
+    r = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=2, polish=False)
     assert r.estimate.shape == (8,) and np.isfinite(r.fitness)
 
 
@@ -295,7 +295,7 @@ def test_the_kernel_cache_is_keyed_by_all_kernel_sources():
 
 
 def test_a_non_finite_history_entry_is_written_as_valid_json():
-    from emaphm.identification.identify import IdentificationResult
+    from emaphm.identification.result import IdentificationResult
 
     r = IdentificationResult(
         estimate=np.array(emaphm.HEALTHY), fitness=1.0, evaluations=1, wall_time_s=0.0, seed=0, optimizer="ga",

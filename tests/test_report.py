@@ -17,9 +17,9 @@ from emaphm.results import SimResult
 from tests.helpers import run_cli
 
 ROOT = Path(__file__).resolve().parents[1]
-BUDGET = {"pop_size": 16, "generations": 3, "local_polish": False}
+BUDGET = {"pop_size": 16, "generations": 3, "polish": False}
 # enough search for the Table 1 faults to come out present (16 x 3 may leave every one "cannot tell")
-FITTED = {"pop_size": 16, "generations": 10, "local_polish": False}
+FITTED = {"pop_size": 16, "generations": 10, "polish": False}
 
 
 class _Page(HTMLParser):
@@ -81,7 +81,7 @@ def test_a_report_shows_the_verdict_faults_and_figures_and_needs_nothing_else(me
     # the fit's caption names the model whose current it shows: the LF model without a last stage,
     # the switching model after one (`FaultIdentifier.curves`)
     assert "the LF model at the identified faults" in text
-    staged = dataclasses.replace(result, settings={**result.settings, "switching_stage": {"taken": True}})
+    staged = dataclasses.replace(result, settings={**result.settings, "stages": [{"stage": "last_stage", "switching": {"taken": True}}]})
     text = " ".join(_read(write_report(staged, tmp_path / "rep3")).text)
     assert "the switching model at the identified faults" in text and "LF model at" not in text
 

@@ -10,7 +10,8 @@ The public API:
   fault vector k1..k8 (DESIGN §2);
 - `Chirp`, `ChirpHold`, `Steps`, `Step`, `Ramp`, `Sine` are position commands;
 - `read_trace` / `write_trace` store traces as HDF5 or CSV;
-- `identify` / `FaultIdentifier` find the fault vector from a measured current (DESIGN §5) and
+- `identify` / `FaultIdentifier` find the fault vector from a measured current (DESIGN §5), run
+  as `IdentifySettings` say, and
   `percent_error` scores it (paper eq. 4, the reading that reproduces Table 1);
 - `calibrate` fits the monitor model to the twin, `load_calibration` reads such a file.
 
@@ -32,8 +33,8 @@ _LAZY = {
     "make_command": "commands",
     "FAULT_NAMES": "faults", "HEALTHY": "faults", "TABLE1_REFERENCE": "faults",
     "apply_faults": "faults", "as_fault_vector": "faults",
-    "FaultIdentifier": "identification.identify", "IdentificationResult": "identification.identify",
-    "identify": "identification.identify",
+    "FaultIdentifier": "identification.identifier", "IdentificationResult": "identification.result",
+    "identify": "identification.api", "IdentifySettings": "identification.settings",
     "percent_error": "identification.metrics", "absolute_errors": "identification.metrics",
     "detect": "identification.detection",
     "calibrate": "identification.calibrate",
@@ -58,6 +59,7 @@ __all__ = [
     "FaultIdentifier",
     "HighFidelityEma",
     "IdentificationResult",
+    "IdentifySettings",
     "InputError",
     "IntegrationParams",
     "InverterParams",
@@ -104,10 +106,13 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .calibration import Calibration, load_calibration
     from .commands import Chirp, ChirpHold, Ramp, Sine, Step, Steps, make_command
     from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
+    from .identification.api import identify
     from .identification.calibrate import calibrate
     from .identification.detection import detect
-    from .identification.identify import FaultIdentifier, IdentificationResult, identify
+    from .identification.identifier import FaultIdentifier
     from .identification.metrics import absolute_errors, percent_error
+    from .identification.result import IdentificationResult
+    from .identification.settings import IdentifySettings
     from .io import read_trace, write_trace
     from .models import HighFidelityEma, MonitorEma, simulate
     from .params import (

@@ -195,7 +195,7 @@ def identify(
     import json
 
     from .faults import parse_faults
-    from .identification.identify import identify as run_identify
+    from .identification.api import identify as run_identify
     from .identification.optimizers import check_optimizer
     from .io import atomic_path, check_output_path, check_trace_path
     from .models import check_seed
@@ -235,9 +235,9 @@ def identify(
     with _progress() as update:
         result = run_identify(
             truth, reference, optimizer=optimizer, seed=seed, workers=workers, pop_size=pop_size,
-            generations=generations, local_polish=polish, second_search=second_search, calibration=calibration, monitor=monitor,
+            generations=generations, polish=polish, second_search=second_search, calibration=calibration, monitor=monitor,
             uncertainty=uncertainty, uq_calibration=uq_calibration, params=params, channel_map=map_file,
-            error_corner_hz=corner, last_stage=last_stage,
+            error_corner=corner, last_stage=last_stage,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{optimizer.upper()} generations", abs(gen), total
             ),
@@ -273,7 +273,7 @@ def identify(
 
 def _error_corner(text: str) -> float | str | None:
     """--error-corner: 'auto', 'off' or a frequency > 0 [Hz] (`identify.parse_error_corner`)."""
-    from .identification.identify import parse_error_corner
+    from .identification.settings import parse_error_corner
 
     try:
         value: float | str = float(text)
@@ -298,8 +298,10 @@ def _print_identification(data: dict[str, Any]) -> None:
             f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.3-3.9 %; "
             "above 6 % a warning, above 50 %: does not fit)"
         )
-    second = data["settings"].get("second_search_run")
-    if second is not None:
+    from .identification.result import stage_record
+
+    second = stage_record(data["settings"], "second_search")
+    if second is not None and second["ran"]:
         ratio = second["fitness_ratio"]
         kept = "its result kept" if second["taken"] else "the first search's result kept"
         out.print(
@@ -307,7 +309,7 @@ def _print_identification(data: dict[str, Any]) -> None:
             f"usual ({100 * second['trigger']:g} %); the second search's fitness "
             f"{'not finite' if ratio is None else f'{ratio:.3f} x the first'}: {kept}"
         )
-    stage = data["settings"].get("switching_stage")
+    stage = (stage_record(data["settings"], "last_stage") or {}).get("switching")
     if stage is not None:
         if "error" in stage:
             out.print(f"switching last stage: not run ({stage['error']}); the search's estimate stands")
@@ -447,7 +449,7 @@ def _progress() -> Iterator[Callable[[str, int, int], None]]:
         return
     from rich.progress import Progress
 
-    from .identification.optimizers import import_cmaes
+    from .identification.cmaes import import_cmaes
 
     import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
 

@@ -27,7 +27,7 @@ from .calibration import Calibration
 from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
 from .identification.detection import detect
-from .identification.identify import identify
+from .identification.api import identify
 from .identification.metrics import percent_error
 from .identification.optimizers import check_optimizer
 from .models import MonitorEma, check_seed, simulate
@@ -58,7 +58,7 @@ def run_demo(
     `calibration` is the LF calibration (default: the packaged one of `monitor`, "default" or
     "paper"); `params` the actuator (`EmaParams` or an actuator file; its calibration must be
     given too, see `emaphm.actuator`); `budget` passes
-    ``pop_size``, ``generations`` and ``local_polish`` to `identify` (the defaults otherwise:
+    ``pop_size``, ``generations`` and ``polish`` to `identify` (the defaults otherwise:
     tests use a small one).
     """
     console = console or Console()

@@ -175,5 +175,7 @@ def _page(data: dict[str, Any], figures: dict[str, bytes], provenance: dict[str,
 def _fit_model(data: dict[str, Any]) -> str:
     """Which model's current the fit shows: the switching model's after a switching last stage
     that ran (`FaultIdentifier.curves`), else the LF monitor's."""
-    stage = data["settings"].get("switching_stage")
+    from .identification.result import stage_record
+
+    stage = (stage_record(data["settings"], "last_stage") or {}).get("switching")
     return "switching model" if stage is not None and "error" not in stage else "LF model"

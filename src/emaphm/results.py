@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .errors import InputError
+
 __all__ = ["REQUIRED_SIGNALS", "UNITS", "SimResult"]
 
 UNITS: dict[str, str] = {
@@ -44,6 +46,10 @@ class SimResult:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        steps = np.diff(np.asarray(self.t, dtype=np.float64))
+        if len(steps) and not np.all(steps > 0):  # np.interp and the filters need it (review L1)
+            row = int(np.flatnonzero(~(steps > 0))[0]) + 1
+            raise InputError(f"the time axis must increase strictly; sample {row} is at or before the one before it")
         for name, values in self.signals.items():
             if values.shape != self.t.shape:
                 raise ValueError(f"signal {name!r} has shape {values.shape}, t has {self.t.shape}")

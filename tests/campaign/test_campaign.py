@@ -258,7 +258,7 @@ def test_a_campaign_job_gives_the_estimate_of_a_lone_identification(tmp_path):
         row = rows[(actuator, flight, seed)]
         k = truth if truth is not None else [row[f"true_k{i}"] for i in range(1, 9)]
         alone = emaphm.identify(true_faults=k, seed=row["identify_seed"], pop_size=6, generations=2,
-                                local_polish=False, uncertainty="none")  # fmt: skip
+                                polish=False, uncertainty="none")  # fmt: skip
         assert [row[f"k{i}"] for i in range(1, 9)] == alone.estimate.tolist()
 
 
@@ -298,7 +298,7 @@ def test_a_store_written_before_a_column_existed_still_reads(tmp_path):
 
 
 def test_a_campaign_sets_the_error_corner_as_identify_does(tmp_path):
-    """[identify] error_corner reaches `emaphm.identify` as error_corner_hz ("off": None)."""
+    """[identify] error_corner reaches `emaphm.identify` as identify takes it ("off": None)."""
     from emaphm.campaign.jobs import identify_kwargs
 
     for given, passed in (('"off"', None), ('"auto"', "auto"), ("3", 3.0), ("1.5", 1.5)):
@@ -308,7 +308,7 @@ def test_a_campaign_sets_the_error_corner_as_identify_does(tmp_path):
         )
         (job,) = load_campaign(tmp_path / "c.toml").jobs()
         kwargs = identify_kwargs(job.to_dict())
-        assert kwargs["error_corner_hz"] == passed and "error_corner" not in kwargs
+        assert kwargs["error_corner"] == passed
 
 
 def test_a_campaign_sets_the_last_stage_as_identify_does(tmp_path):
@@ -353,12 +353,11 @@ def test_a_results_row_records_the_second_search(tmp_path, monkeypatch):
     import json
 
     from emaphm.campaign.jobs import run_job
-    from emaphm.identification import identify as identify_module
-    from emaphm.identification import optimizers
+    from emaphm.identification import limits
 
     # a trigger every fit exceeds and a tiny polish: each job searches twice
-    monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.0)
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setitem(limits.SECOND_SEARCH_NRMSE, "default", 0.0)
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
     rows = {}
     for second in ("true", "false"):
         (tmp_path / "c.toml").write_text(

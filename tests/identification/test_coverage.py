@@ -56,7 +56,7 @@ def test_another_command_is_flagged_and_a_tiny_difference_is_not():
 
 def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_path, capsys):
     trace = emaphm.simulate(emaphm.HEALTHY, model="lf", command=Step(), noise=False)
-    r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
+    r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, polish=False)
     assert r.warnings and "none of those" in r.warnings[0]
     assert r.to_json()["warnings"] == r.warnings
     path = tmp_path / "step.h5"
@@ -84,19 +84,19 @@ def test_identify_reports_the_warning_in_its_result_and_on_the_command_line(tmp_
 
 
 def test_the_twin_on_the_fdi_chirp_raises_no_warning():
-    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=16, generations=3, local_polish=False)
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, pop_size=16, generations=3, polish=False)
     # this 16 x 3 budget fits poorly (about 30 % NRMSE) and says so; nothing else may be said
     assert r.verdict == "fits" and [w for w in r.warnings if not w.startswith("the fit is poor")] == []
 
 
 def test_a_chirp_with_a_hold_is_covered_and_its_held_samples_are_left_out():
     trace = emaphm.simulate(emaphm.HEALTHY, command=ChirpHold(), noise=True, seed=3)
-    r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, local_polish=False)
+    r = emaphm.identify(reference=trace, seed=1, pop_size=8, generations=1, polish=False)
     assert not any("calibrated on" in w for w in r.warnings)  # (a 8 x 1 search need not fit)
     # the command parks from 1.05 s: left out from PARK_SETTLE_S later, whatever the surface does
     # (its slips there, the loop hunting against friction, kept 0.64-0.70 of the samples before),
     # or from REST_SETTLE_S once the surface rests at a current below the monitor's ring edge
-    from emaphm.identification.fitness import PARK_SETTLE_S, REST_SETTLE_S
+    from emaphm.identification.weights import PARK_SETTLE_S, REST_SETTLE_S
 
     compared = r.settings["samples_compared"]
     assert (1.05 + REST_SETTLE_S) / 2.0 - 2e-3 <= compared <= (1.05 + PARK_SETTLE_S) / 2.0 + 2e-3
@@ -117,17 +117,17 @@ def test_a_recording_that_is_mostly_a_rest_and_thresholds_of_another_monitor_are
     )
     # at a current below the monitor's ring edge the rest is left out after 5 ms: nothing to compare
     with pytest.raises(InputError, match="only 51 samples of the recording can be compared"):
-        emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
+        emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, polish=False)
     rest.signals["i_q"] = rest.signals["i_q"] + 0.2  # the loop holding against a load: 20 ms compared
-    r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, local_polish=False)
+    r = emaphm.identify(reference=rest, seed=1, pop_size=8, generations=1, polish=False)
     assert r.settings["samples_compared"] < 0.15  # the first 20 ms of the 0.5 s park
     assert any("of the recording is compared" in w for w in r.warnings)
     r = emaphm.identify(
-        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False, monitor="paper"
+        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, polish=False, monitor="paper"
     )
     assert any("thresholds were measured with the 'default' monitor" in w for w in r.warnings)
     r = emaphm.identify(
-        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, local_polish=False, monitor="paper",
+        true_faults=emaphm.HEALTHY, seed=1, pop_size=8, generations=1, polish=False, monitor="paper",
         thresholds={},
     )  # fmt: skip
     assert not any("thresholds" in w for w in r.warnings)

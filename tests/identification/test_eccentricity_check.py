@@ -4,15 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from emaphm.identification.identify import (
-    ECC_AT_BOUND,
-    ECC_DIRECTIONS,
-    ECC_PROBE,
-    ECC_PROBE_GAIN,
-    search_to_faults,
-    try_eccentricity_directions,
-)
+from emaphm.identification.checks import try_eccentricity_directions
+from emaphm.identification.limits import ECC_AT_BOUND, ECC_DIRECTIONS, ECC_PROBE, ECC_PROBE_GAIN
 from emaphm.identification.optimizers import OptimizerRun
+from emaphm.identification.problem import search_to_faults
 
 OTHERS = np.array([0.2, 0.1, 0.05, 0.4, 0.0, 0.5])  # k1..k5 and k8
 
@@ -104,7 +99,8 @@ def test_the_restart_is_polished_with_the_whole_budget():
     # gains far below the early stop's tolerance (1e-3 relative) around the restart: the usual
     # polish would stop after 15 generations without gain; the restart's runs on (up to its whole
     # budget, or until CMA-ES's own tolerances end it)
-    from emaphm.identification.optimizers import POLISH_BUDGET, polish
+    from emaphm.identification.limits import POLISH_BUDGET
+    from emaphm.identification.polish import polish
 
     bowl = polar(0.05, 0.6)
 
@@ -122,7 +118,7 @@ def test_the_restart_is_polished_with_the_whole_budget():
 
 
 def test_the_final_checks_take_the_best_finite_candidate_and_count_its_evaluations():
-    from emaphm.identification.identify import best_candidate
+    from emaphm.identification.checks import best_candidate
 
     run = OptimizerRun(point(0.0, 0.3), 1.0, 100, [])
     X = np.repeat(run.x[None, :], 4, axis=0)

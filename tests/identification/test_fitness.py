@@ -69,7 +69,7 @@ def test_reference_on_another_grid_is_interpolated():
 
 def test_the_moving_mask_leaves_out_a_park_and_the_rests_of_a_staircase():
     from emaphm.commands import ChirpHold, Steps
-    from emaphm.identification.fitness import PARK_SETTLE_S, REST_BAND, moving_mask
+    from emaphm.identification.weights import PARK_SETTLE_S, REST_BAND, moving_mask
 
     f_s = 1e4
     t = np.arange(20001) / f_s
@@ -93,7 +93,7 @@ def test_the_moving_mask_leaves_out_a_park_and_the_rests_of_a_staircase():
 
 def test_the_moving_mask_leaves_out_rests_whose_current_is_below_the_ring_edge():
     from emaphm.commands import Chirp, Steps
-    from emaphm.identification.fitness import HOLD_SETTLE_S, REST_SETTLE_S, moving_mask
+    from emaphm.identification.weights import HOLD_SETTLE_S, REST_SETTLE_S, moving_mask
 
     f_s = 1e4
     t = np.arange(10001) / f_s
@@ -170,7 +170,7 @@ def test_a_fast_recording_is_low_passed_before_it_is_resampled():
 
 def test_command_frequency_reads_a_sine_a_chirp_and_ignores_noise():
     from emaphm.commands import Steps
-    from emaphm.identification.fitness import command_frequency
+    from emaphm.identification.weights import command_frequency
 
     f_s = 1e4
     t = np.arange(20001) / f_s
@@ -199,7 +199,7 @@ def test_command_frequency_reads_a_sine_a_chirp_and_ignores_noise():
 
 def test_the_band_mask_leaves_out_only_motion_faster_than_the_fdi_chirp():
     from emaphm.commands import ChirpHold, Steps
-    from emaphm.identification.fitness import BAND_HZ, band_mask
+    from emaphm.identification.weights import BAND_HZ, band_mask
 
     f_s = 1e4
     t = np.arange(20001) / f_s
@@ -213,7 +213,7 @@ def test_the_band_mask_leaves_out_only_motion_faster_than_the_fdi_chirp():
 
 
 def test_error_weights_follow_the_command_frequency_and_the_emphasis_scales_eq3():
-    from emaphm.identification.fitness import error_weights
+    from emaphm.identification.weights import error_weights
 
     f_s = 1e4
     t = np.arange(10001) / f_s
@@ -228,7 +228,7 @@ def test_error_weights_follow_the_command_frequency_and_the_emphasis_scales_eq3(
     # follows it weigh as the chirp's 10 Hz end, the hold after them as slow; the rising sweep alone
     # is unchanged by that memory
     from emaphm.commands import ChirpHold
-    from emaphm.identification.fitness import ERROR_CORNER_HZ, ERROR_MEMORY_S, command_frequency
+    from emaphm.identification.weights import ERROR_CORNER_HZ, ERROR_MEMORY_S, command_frequency
 
     hold = ChirpHold()
     th = np.arange(int(hold.duration * f_s) + 1) / f_s

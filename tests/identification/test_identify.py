@@ -6,15 +6,16 @@ import pytest
 import emaphm
 from emaphm import InputError
 from emaphm.commands import Chirp
-from emaphm.identification import optimizers
+from emaphm.identification import limits
+from emaphm.identification.api import identify
 from emaphm.identification.detection import detect
-from emaphm.identification.identify import FaultIdentifier, identify
+from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.metrics import absolute_errors, percent_error
 from emaphm.identification.optimizers import OPTIMIZERS, Stagnation, run_optimizer
 
 # Budgets. The global search only has to land in the right basin; the CMA-ES polish does the
 # converging. TINY checks plumbing and determinism, not convergence.
-TINY = {"pop_size": 16, "generations": 3, "local_polish": False}
+TINY = {"pop_size": 16, "generations": 3, "polish": False}
 RECOVERY = {"pop_size": 16, "generations": 5}  # with the polish, shrunk by the `small_polish` fixture
 
 
@@ -41,24 +42,24 @@ def measured():
 @pytest.mark.parametrize(("case", "tol"), [("backlash", 0.01), ("friction+shortB", 0.04)])
 def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, tol):
     truth, r = measured[case]
-    ident = FaultIdentifier("ga", seed=1, **RECOVERY).fit(r.t, r.i_q, Chirp())
+    ident = FaultIdentifier(seed=1, **RECOVERY).fit(r.t, r.i_q, Chirp())
     err = absolute_errors(ident.faults_, truth)
     assert np.all(np.delete(err, 6) < tol), err
     pop, gen = small_polish
     # the GA, the polish of its best point and of its runner-up, the final check of the shorts (8),
     # one more polish if a candidate fits better, and the least-squares polish (a Jacobian of 8
     # rows per residual evaluation at most, and the final value)
-    ls = 1 + optimizers.LS_MAX_NFEV * (1 + 8) + 1
+    ls = 1 + limits.LS_MAX_NFEV * (1 + 8) + 1
     assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8 + ls
 
 
 def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
     # determinism needs no convergence: a tiny GA, then a tiny polish (its seed path too)
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
     _, r = measured["friction+shortB"]
 
     def run(seed, polish):
-        return FaultIdentifier("ga", seed=seed, **{**TINY, "local_polish": polish}).fit(r.t, r.i_q).faults_
+        return FaultIdentifier(seed=seed, **{**TINY, "polish": polish}).fit(r.t, r.i_q).faults_
 
     found = {}
     for polish in (False, True):
@@ -70,22 +71,22 @@ def test_same_seed_same_estimate_other_seed_differs(measured, monkeypatch):
 
 
 def test_the_least_squares_polish_ends_the_identification_and_never_makes_it_worse(measured, monkeypatch):
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))  # a tiny search leaves it work to do
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))  # a tiny search leaves it work to do
     _, r = measured["friction+shortB"]
-    ident = FaultIdentifier("ga", seed=3, pop_size=16, generations=3, last_stage="none").fit(r.t, r.i_q)
-    assert ident.least_squares_gain_ is not None and ident.least_squares_gain_ < 0.9
+    ident = FaultIdentifier(seed=3, pop_size=16, generations=3, last_stage="none").fit(r.t, r.i_q)
+    assert ident.record("least_squares")["gain"] < 0.9
     # the value kept is eq. (3) at the estimate, as the search computes it
     at = ident.objective_.of_monitor(ident.monitor_, ident.faults_[None, :], duration=ident.duration_)[0]
     assert ident.fitness_ == pytest.approx(float(at), rel=1e-9)
     # and the residuals it works on are eq. (3)'s: Σ r² equals the search's fitness row by row
-    from emaphm.identification.identify import search_to_faults
+    from emaphm.identification.problem import search_to_faults
 
     X = np.random.default_rng(0).uniform(0.0, 0.6, (3, 8))
     R = ident.residuals()(X)
     f = ident.objective_.of_monitor(ident.monitor_, search_to_faults(X), duration=ident.duration_)
     np.testing.assert_allclose(np.sum(R**2, axis=1), f, rtol=1e-9)
-    plain = FaultIdentifier("ga", seed=3, **TINY).fit(r.t, r.i_q)
-    assert plain.least_squares_gain_ is None  # no polish asked: none of either kind
+    plain = FaultIdentifier(seed=3, **TINY).fit(r.t, r.i_q)
+    assert plain.record("least_squares") == {"stage": "least_squares", "ran": False}  # no polish asked
 
 
 @pytest.mark.parametrize("name", OPTIMIZERS)
@@ -144,7 +145,7 @@ def test_identify_bad_input(tmp_path):
 
 
 def test_phase_map_wraps_and_keeps_every_phase_away_from_the_bounds():
-    from emaphm.identification.identify import search_to_faults
+    from emaphm.identification.problem import search_to_faults
 
     x = np.tile(np.linspace(0, 1, 201)[:, None], (1, 8))
     k = search_to_faults(x)
@@ -159,8 +160,8 @@ def test_rests_the_loop_may_or_may_not_carry_are_left_out_by_the_monitor_with_a_
     """A staircase: the default monitor (i_D > 0) leaves out the rests whose measured current is
     below its ring edge; the paper monitor (no dead zone) keeps the earlier rule."""
     from emaphm.commands import SampledCommand, Steps
-    from emaphm.identification.fitness import band_mask, moving_mask
-    from emaphm.identification.identify import FaultIdentifier
+    from emaphm.identification.identifier import FaultIdentifier
+    from emaphm.identification.weights import band_mask, moving_mask
     from emaphm.kernels.monitor import RING_OUTER
     from emaphm.models import HighFidelityEma, MonitorEma
 
@@ -184,9 +185,11 @@ def test_rests_the_loop_may_or_may_not_carry_are_left_out_by_the_monitor_with_a_
 def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitted():
     """The chirp run on to 2 s: the second above 10 Hz is left out, and not simulated at all."""
     from emaphm.commands import Chirp, SampledCommand
-    from emaphm.identification.fitness import Fitness, error_weights
-    from emaphm.identification.identify import TAIL_MARGIN_S, FaultIdentifier
+    from emaphm.identification.fitness import Fitness
+    from emaphm.identification.identifier import FaultIdentifier
+    from emaphm.identification.limits import TAIL_MARGIN_S
     from emaphm.identification.signals import Comparison
+    from emaphm.identification.weights import error_weights
     from emaphm.models import HighFidelityEma, MonitorEma
 
     command = Chirp(T=2.0, f1=19.5)
@@ -213,7 +216,7 @@ def test_a_recording_above_the_band_is_compared_only_where_the_monitor_was_fitte
         rtol=1e-9,
     )
     # the figures show the whole recording: the LF current up to the span simulated, NaN after it
-    ident = FaultIdentifier(pop_size=8, generations=1, local_polish=False, monitor=MonitorEma())
+    ident = FaultIdentifier(pop_size=8, generations=1, polish=False, monitor=MonitorEma())
     curves = ident.fit(trace.t, trace.i_q, recorded, trace.theta_u).curves()
     assert curves["t"][-1] == pytest.approx(2.0) and len(curves["measured"]) == len(curves["t"])
     inside = curves["t"] <= ident.duration_ + 1e-9
@@ -229,13 +232,14 @@ def test_the_fitness_weights_motion_by_the_monitors_error_growing_with_frequency
     """The default monitor's eq. 3 counts the chirp's fast end less (`fitness.error_weights`); the
     paper's monitor keeps the paper's eq. 3; the corner is recorded and a bad one refused."""
     from emaphm.commands import SampledCommand
-    from emaphm.identification.fitness import ERROR_CORNER_HZ, Fitness, error_weights
-    from emaphm.identification.identify import FaultIdentifier, resolve_error_corner
+    from emaphm.identification.fitness import Fitness
+    from emaphm.identification.identifier import FaultIdentifier
+    from emaphm.identification.weights import ERROR_CORNER_HZ, error_weights, resolve_error_corner
     from emaphm.models import MonitorEma
 
     trace = emaphm.simulate([0.1, 0, 0.2, 0, 0, 0, 0, 0.5], duration=1.0)
     command = SampledCommand(trace.t, trace.theta_cmd)
-    plain = FaultIdentifier(monitor=MonitorEma(), error_corner_hz=None).prepare(trace.t, trace.i_q, command)
+    plain = FaultIdentifier(monitor=MonitorEma(), error_corner=None).prepare(trace.t, trace.i_q, command)
     auto = FaultIdentifier(monitor=MonitorEma()).prepare(trace.t, trace.i_q, command)
     assert plain.error_corner_hz_ is None and auto.error_corner_hz_ == ERROR_CORNER_HZ
     _, theta = auto.monitor_.sample_grid(auto.duration_)
@@ -253,4 +257,4 @@ def test_the_fitness_weights_motion_by_the_monitors_error_growing_with_frequency
         with pytest.raises(InputError, match="error corner"):
             resolve_error_corner(bad, "default")
     with pytest.raises(InputError, match="error corner"):
-        identify([0] * 7 + [0.5], error_corner_hz=-2.0)
+        identify([0] * 7 + [0.5], error_corner=-2.0)

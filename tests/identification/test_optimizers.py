@@ -15,11 +15,10 @@ from emaphm.identification.optimizers import (
     BatchProblem,
     OptimizerRun,
     Stagnation,
-    least_squares_polish,
     minimize_batch,
-    polish,
     run_optimizer,
 )
+from emaphm.identification.polish import least_squares_polish, polish
 
 CENTRE = np.array([0.2, 0.7, 0.4, 0.1, 0.9, 0.5, 0.3, 0.6])
 BUDGET = {"pop_size": 20, "generations": 50}
@@ -246,7 +245,7 @@ def test_import_cmaes_puts_the_blocked_modules_back_when_the_import_fails(monkey
     import sys
     import threading
 
-    from emaphm.identification.optimizers import CMA_UNUSED_IMPORTS, import_cmaes
+    from emaphm.identification.cmaes import CMA_UNUSED_IMPORTS, import_cmaes
 
     for name in ("cma", *CMA_UNUSED_IMPORTS):
         monkeypatch.delitem(sys.modules, name, raising=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from emaphm.identification.identify import try_short_permutations
+from emaphm.identification.checks import try_short_permutations
 from emaphm.identification.optimizers import OptimizerRun
 
 TRUTH = np.array([0.2, 0.1, 0.05, 0.4, 0.0, 0.1, 0.3, 0.5])
@@ -66,7 +66,7 @@ def test_a_spurious_short_is_zeroed():
 
 
 def test_the_phase_is_moved_off_a_bound_of_the_box_without_changing_the_faults():
-    from emaphm.identification.identify import recentre_phase, search_to_faults
+    from emaphm.identification.problem import recentre_phase, search_to_faults
 
     for x7 in (0.0, 0.1, 0.3, 0.5, 0.74, 0.9, 1.0):
         x = TRUTH.copy()
@@ -88,7 +88,7 @@ def two_basins(X):
 
 
 def test_the_runner_up_is_the_best_member_of_another_basin():
-    from emaphm.identification.identify import runner_up
+    from emaphm.identification.polish import runner_up
 
     close = A + 0.01  # the same basin: within RUNNER_UP_DISTANCE in every fault
     same_phase = A.copy()
@@ -106,7 +106,7 @@ def test_the_runner_up_is_the_best_member_of_another_basin():
 
 
 def test_polishing_the_runner_up_escapes_a_neighbouring_basin():
-    from emaphm.identification.identify import polish_two
+    from emaphm.identification.polish import polish_two
 
     population = np.array([A, A - 0.01, B + 0.05])
     run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))

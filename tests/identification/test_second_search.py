@@ -7,17 +7,13 @@ import pytest
 
 import emaphm
 from emaphm.commands import Chirp
-from emaphm.identification import identify as identify_module
-from emaphm.identification import optimizers
-from emaphm.identification.identify import (
-    FIT_NRMSE_LIMIT,
-    SECOND_SEARCH_NRMSE,
-    FaultIdentifier,
-    _Search,
-    identify,
-    second_seed,
-)
+from emaphm.identification import limits, search
+from emaphm.identification.api import identify
+from emaphm.identification.identifier import FaultIdentifier
+from emaphm.identification.limits import FIT_NRMSE_LIMIT, SECOND_SEARCH_NRMSE
 from emaphm.identification.optimizers import OptimizerRun
+from emaphm.identification.second_search import second_seed
+from emaphm.identification.state import State
 from emaphm.models import MonitorEma
 
 FAULTS = [0.3, 0, 0, 0.3, 0, 0, 0, 0.5]
@@ -30,17 +26,23 @@ def trace():
 
 
 def canned(by_seed):
-    """A stand-in for `FaultIdentifier._search`: the search from each seed as given (x, f, fit
-    NRMSE, evaluations); what it did is recorded under its seed, so the kept one can be told."""
+    """A stand-in for `search.run_search`: the search from each seed as given (x, f, fit NRMSE,
+    evaluations); what its stages did is recorded under its seed, so the kept one can be told."""
 
-    def search(self, evaluate, seed):
+    def run_search(context):
+        seed = context.seed
         x, f, fit, evaluations = by_seed[seed]
         run = OptimizerRun(np.full(8, x), f, evaluations, [f] * (seed % 5 + 1))
-        return _Search(
-            run, fit, None, seed % 2 == 0, [seed % 3, 0, 1], f"move {seed}", None, 1.0 / (seed + 1)
-        )
+        records = [
+            {"stage": "search", "seed": seed},
+            {"stage": "polish", "runner_up": seed % 2 == 0},
+            {"stage": "final_checks", "short_permutation": [seed % 3, 0, 1], "short_check": f"move {seed}"},
+            {"stage": "least_squares", "gain": 1.0 / (seed + 1)},
+            {"stage": "fit", "fit_nrmse": fit},
+        ]
+        return State(run, fit, None), records
 
-    return search
+    return run_search
 
 
 FIRST_F = 2.0  # the first search's fitness
@@ -59,10 +61,10 @@ FIRST_F = 2.0  # the first search's fitness
 def test_a_poor_fit_searches_again_and_keeps_the_lower_fitness(trace, monkeypatch, first_fit, second, taken):
     other = second_seed(7)
     monkeypatch.setattr(
-        FaultIdentifier, "_search", canned({7: (0.1, FIRST_F, first_fit, 100), other: (*second, 37)})
+        search, "run_search", canned({7: (0.1, FIRST_F, first_fit, 100), other: (*second, 37)})
     )
     ident = FaultIdentifier(seed=7, last_stage="none").fit(trace.t, trace.i_q, Chirp())
-    record = ident.second_search_
+    record = ident.record("second_search")
     x, f, fit = second
     assert record is not None and record["taken"] is taken and record["seed"] == other
     assert record["trigger"] == TRIGGER and record["first_fit_nrmse"] == first_fit
@@ -73,8 +75,10 @@ def test_a_poor_fit_searches_again_and_keeps_the_lower_fitness(trace, monkeypatc
     assert ident.fitness_ == (f if taken else FIRST_F) and ident.fit_nrmse_ == (fit if taken else first_fit)
     kept = other if taken else 7
     # what the kept search did, and its history (one value per generation)
-    assert ident.short_move_ == f"move {kept}" and ident.permutation_ == [kept % 3, 0, 1]
-    assert ident.runner_up_won_ is (kept % 2 == 0) and ident.least_squares_gain_ == 1.0 / (kept + 1)
+    checks = ident.record("final_checks")
+    assert checks["short_check"] == f"move {kept}" and checks["short_permutation"] == [kept % 3, 0, 1]
+    assert ident.record("polish")["runner_up"] is (kept % 2 == 0)
+    assert ident.record("least_squares")["gain"] == 1.0 / (kept + 1)
     assert len(ident.run_.history) == kept % 5 + 1
     assert ident.faults_[0] == pytest.approx(x if taken else 0.1)
 
@@ -87,14 +91,14 @@ def test_a_poor_fit_searches_again_and_keeps_the_lower_fitness(trace, monkeypatc
         (1.1 * FIT_NRMSE_LIMIT, {}),  # no fit at all (units, signs): a recording problem, not a basin
         (np.inf, {}),  # the LF run at the estimate diverged
         (2 * TRIGGER, {"second_search": False}),
-        (2 * TRIGGER, {"local_polish": False}),  # a raw search was asked for
+        (2 * TRIGGER, {"polish": False}),  # a raw search was asked for
     ],
 )
 def test_no_second_search_where_it_cannot_help_or_was_not_asked(trace, monkeypatch, fit, settings):
     # any other seed than the first's: KeyError
-    monkeypatch.setattr(FaultIdentifier, "_search", canned({7: (0.1, 1.0, fit, 100)}))
+    monkeypatch.setattr(search, "run_search", canned({7: (0.1, 1.0, fit, 100)}))
     ident = FaultIdentifier(seed=7, last_stage="none", **settings).fit(trace.t, trace.i_q, Chirp())
-    assert ident.second_search_ is None and ident.run_.evaluations == 100
+    assert ident.record("second_search")["ran"] is False and ident.run_.evaluations == 100
 
 
 def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
@@ -103,8 +107,8 @@ def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
     between = 0.5 * (SECOND_SEARCH_NRMSE["default"] + SECOND_SEARCH_NRMSE["paper"])
     assert SECOND_SEARCH_NRMSE["default"] < between < SECOND_SEARCH_NRMSE["paper"]
     monkeypatch.setattr(
-        FaultIdentifier,
-        "_search",
+        search,
+        "run_search",
         canned({7: (0.1, 1.0, between, 100), second_seed(7): (0.2, 0.9, 0.01, 100)}),
     )
     ran = {}
@@ -112,19 +116,19 @@ def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
         ident = FaultIdentifier(seed=7, last_stage="none", monitor=MonitorEma(monitor=name)).fit(
             trace.t, trace.i_q, Chirp()
         )
-        ran[name] = ident.second_search_
-    assert ran["paper"] is None and ran["default"]["trigger"] == SECOND_SEARCH_NRMSE["default"]
+        ran[name] = ident.record("second_search")
+    assert ran["paper"]["ran"] is False and ran["default"]["trigger"] == SECOND_SEARCH_NRMSE["default"]
 
 
 def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monkeypatch):
     # a small search (pop 16 x 3, a tiny polish) fits this actuator to 2.2 % at every seed tried:
     # a trigger at half that must start the second search
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
-    monkeypatch.setitem(identify_module.SECOND_SEARCH_NRMSE, "default", 0.01)
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setitem(limits.SECOND_SEARCH_NRMSE, "default", 0.01)
     budget = {"pop_size": 16, "generations": 3}
     res = identify(reference=trace, seed=3, uncertainty="none", last_stage="none", **budget)
-    record = res.settings["second_search_run"]
-    assert res.settings["second_search"] is True and record is not None
+    record = res.stage("second_search")
+    assert record["enabled"] is True and record["ran"] is True
     first_seed = res.settings["optimizer_seed"]
     alone = [
         FaultIdentifier(seed=s, second_search=False, last_stage="none", **budget).fit(
@@ -143,8 +147,8 @@ def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monk
     off = identify(
         reference=trace, seed=3, uncertainty="none", last_stage="none", second_search=False, **budget
     )
-    assert (
-        off.settings["second_search"] is False
-        and off.settings["second_search_run"] is None
-        and off.fitness == pytest.approx(alone[0].fitness_, rel=1e-9)
-    )
+    assert off.stage("second_search") == {
+        "stage": "second_search",
+        "enabled": False,
+        "ran": False,
+    } and off.fitness == pytest.approx(alone[0].fitness_, rel=1e-9)

@@ -206,10 +206,10 @@ def test_the_packaged_calibration_belongs_to_the_packaged_monitor():
 
 
 def test_identify_takes_the_interval_calibration_of_its_last_stage_and_warns_on_another(monkeypatch):
-    from emaphm.identification import optimizers
-    from emaphm.identification.identify import identify
+    from emaphm.identification import limits
+    from emaphm.identification.api import identify
 
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
     small = {"pop_size": 8, "generations": 2, "seed": 1}
     k = [0.2, 0, 0, 0, 0, 0, 0, 0.5]
     for stage in ("switching", "none"):
@@ -222,7 +222,7 @@ def test_identify_takes_the_interval_calibration_of_its_last_stage_and_warns_on_
 
 
 def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
-    from emaphm.identification.mcmc import sample
+    from emaphm.identification.uncertainty.mcmc import sample
 
     n = 2000
     monitor = LinearMonitor(n)
@@ -232,20 +232,9 @@ def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
     fit = Fitness(Comparison.from_signal(t, measured, F_S))
     objective = LinearObjective(fit)
 
-    class Ident:
-        faults_, monitor_, duration_, objective_, final_objective_ = (
-            truth,
-            monitor,
-            None,
-            objective,
-            objective,
-        )
-
     local = laplace(fit, monitor, truth)  # type: ignore[arg-type]
-    runs = [
-        sample(Ident(), local, factors=Factors.identity(), seed=5, walkers=16, chunk=100, max_steps=300)  # type: ignore[arg-type]
-        for _ in range(2)
-    ]
+    options = {"duration": None, "factors": Factors.identity(), "seed": 5, "walkers": 16, "chunk": 100, "max_steps": 300}
+    runs = [sample(objective, monitor, truth, local, **options) for _ in range(2)]  # type: ignore[arg-type]
     np.testing.assert_array_equal(runs[0].ci90_low, runs[1].ci90_low)
     assert runs[0].details["steps"] == 300 and not runs[0].details["converged"]
     width_mcmc = runs[0].ci90_high - runs[0].ci90_low
@@ -254,11 +243,11 @@ def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
     np.testing.assert_allclose(width_mcmc[[0, 1, 2, 3, 4, 7]], width_laplace[[0, 1, 2, 3, 4, 7]], rtol=0.35)
 
 
-TINY = {"pop_size": 16, "generations": 3, "local_polish": False}
+TINY = {"pop_size": 16, "generations": 3, "polish": False}
 
 
 def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_says_so():
-    from emaphm.identification.identify import identify
+    from emaphm.identification.api import identify
 
     res = identify([0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, monitor="paper", **TINY)
     if not res.fits:  # a 16 x 3 search may not explain the measurement: then no intervals at all
@@ -272,8 +261,8 @@ def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_sa
 
 
 def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):
-    from emaphm.identification import mcmc
-    from emaphm.identification.identify import identify
+    from emaphm.identification.api import identify
+    from emaphm.identification.uncertainty import mcmc
 
     monkeypatch.setattr(mcmc, "MAX_STEPS", 60)
     monkeypatch.setattr(mcmc, "CHUNK", 30)
@@ -329,7 +318,7 @@ def test_non_finite_details_become_null_in_json():
 def test_the_sandwich_convolution_is_fftconvolves_same(n, half):
     from scipy.signal import fftconvolve
 
-    from emaphm.identification.uncertainty import _convolve_same
+    from emaphm.identification.uncertainty.laplace import _convolve_same
 
     rng = np.random.default_rng(n + half)
     g = rng.normal(size=(n, 3))

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 import emaphm
-from emaphm.identification.identify import FIT_NRMSE_LIMIT, FIT_NRMSE_WARN
+from emaphm.identification.limits import FIT_NRMSE_LIMIT, FIT_NRMSE_WARN
 from emaphm.results import SimResult
 from tests.helpers import run_cli
 
-BUDGET = {"pop_size": 16, "generations": 3, "local_polish": False}
+BUDGET = {"pop_size": 16, "generations": 3, "polish": False}
 
 
 @pytest.fixture(scope="module")
@@ -79,11 +79,11 @@ def test_a_recording_too_short_for_a_diagnosis_is_refused(measured):
 
 
 def test_a_current_gain_error_fits_poorly_and_is_warned_about(measured, monkeypatch):
-    from emaphm.identification import optimizers
+    from emaphm.identification import limits
 
     # a small search with a short polish fits the true recording to about 2 % and the one with a
     # 1.2x current sensor gain to about 10 %: only the second carries the poor-fit warning
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (16, 10))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (16, 10))
     budget = {"pop_size": 16, "generations": 3, "second_search": False, "uncertainty": "none"}
     signals = dict(measured.signals)
     found = {}

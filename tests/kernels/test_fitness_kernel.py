@@ -8,8 +8,8 @@ from scipy.signal import butter, sosfilt_zi, sosfiltfilt
 
 from emaphm import MonitorEma
 from emaphm._threads import numba_threads
-from emaphm.identification import identify as identify_module
 from emaphm.identification.fitness import Fitness
+from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.signals import Comparison, sosfiltfilt_padlen
 from emaphm.kernels.fitness import filtered_fitness, fitness_lf_many, pairwise_sum
 from emaphm.kernels.monitor import IDX
@@ -185,6 +185,6 @@ def test_identification_runs_on_the_fused_kernel(monkeypatch):
 
     monkeypatch.setattr(Fitness, "of_monitor", counted)
     res = MonitorEma().simulate([0.3, 0, 0, 0, 0, 0, 0, 0.5], noise=True, duration=0.05)
-    ident = identify_module.FaultIdentifier("ga", seed=1, pop_size=8, generations=2, local_polish=False)
+    ident = FaultIdentifier(seed=1, pop_size=8, generations=2, polish=False)
     ident.fit(res.t, res.i_q)
     assert len(calls) >= 2 and np.isfinite(ident.fitness_)

@@ -24,10 +24,6 @@ def identify_kwargs(job: dict[str, Any], *, workers: int | None = 1) -> dict[str
     """The `emaphm.identify` arguments of a job (`spec.Job.to_dict`)."""
     settings = dict(job["settings"])
     kwargs: dict[str, Any] = {"seed": job["identify_seed"], "workers": workers}
-    if "polish" in settings:
-        kwargs["local_polish"] = settings.pop("polish")
-    if "error_corner" in settings:  # "auto", None (the paper's eq. 3, "off" in the file) or Hz
-        kwargs["error_corner_hz"] = settings.pop("error_corner")
     kwargs.update(settings)
     if job["truth"] is not None:
         kwargs["true_faults"] = job["truth"]
@@ -54,7 +50,8 @@ def _now() -> str:
 
 def run_job(job: dict[str, Any]) -> dict[str, Any]:
     """Run one job and return its results row (`store.RESULT_COLUMNS` plus campaign and actuator)."""
-    from ..identification.identify import identify
+    from ..identification.api import identify
+    from ..identification.result import stage_record
 
     result = identify(**identify_kwargs(job))
     data = result.to_json()
@@ -67,7 +64,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
         "fault_verdicts": None if data["fault_verdicts"] is None else json.dumps(data["fault_verdicts"]),
         "fit_nrmse": data["fit_nrmse"], "fitness": data["fitness"], "evaluations": data["evaluations"],
         "wall_time_s": data["wall_time_s"], "reference": job["reference"],
-        "second_search": None if (second := data["settings"].get("second_search_run")) is None else json.dumps(second),
+        "second_search": json.dumps(second) if (second := stage_record(data["settings"], "second_search") or {}).get("ran") else None,
         "reference_sha256": job["reference_sha256"], "settings": json.dumps(job["settings"], sort_keys=True),
         "warnings": json.dumps(data["warnings"]), "worker": _worker(), "finished": _now(), "version": __version__,
         "numba_threads": _pool(),

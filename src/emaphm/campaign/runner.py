@@ -69,9 +69,9 @@ def _warm_up() -> None:
     """Load (or compile) every kernel once here, before workers start: concurrent first
     compilations of a cached numba function race (numba #10128)."""
     from ..faults import HEALTHY
-    from ..identification.identify import identify
+    from ..identification.api import identify
 
-    identify(true_faults=HEALTHY, seed=0, pop_size=4, generations=1, local_polish=False, uncertainty="none",
+    identify(true_faults=HEALTHY, seed=0, pop_size=4, generations=1, polish=False, uncertainty="none",
              workers=1)  # fmt: skip
 
 

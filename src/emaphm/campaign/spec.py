@@ -395,7 +395,7 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
     for key, value in data.items():
         kind = IDENTIFY_KEYS[key]
         if key == "error_corner":  # as identify --error-corner; stored as identify takes it
-            from ..identification.identify import parse_error_corner
+            from ..identification.settings import parse_error_corner
 
             try:
                 out[key] = parse_error_corner(value, name="error_corner")
@@ -412,7 +412,7 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
         else:
             out[key] = value
     from ..identification.optimizers import check_optimizer
-    from ..identification.uncertainty import UQ_METHODS
+    from ..choices import UQ_METHODS
 
     try:
         check_optimizer(out.get("optimizer", "ga"))
@@ -420,7 +420,7 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
         raise _fail(where, f"[identify] {exc}") from None
     if out.get("uncertainty", "laplace") not in UQ_METHODS:
         raise _fail(where, f"[identify] uncertainty must be one of {', '.join(UQ_METHODS)}")
-    from ..identification.switching import LAST_STAGES
+    from ..choices import LAST_STAGES
 
     if out.get("last_stage", "auto") not in LAST_STAGES:
         raise _fail(where, f"[identify] last_stage must be one of {', '.join(LAST_STAGES)}")

@@ -1,10 +1,56 @@
-"""Comparison of signals, calibration of the monitor model, fault identification and detection.
+"""Fault identification (paper §5, DESIGN §5): the fault vector whose LF current best fits a measurement.
 
-The identification entry points are re-exported by the top-level package:
-``emaphm.identify``, ``emaphm.FaultIdentifier``, ``emaphm.percent_error``.
+The pipeline, one module per stage (`identifier.FaultIdentifier.fit` runs 1-5 in order, each
+``stage(state, context) -> (state, record)``; `api.identify` adds 6 and 7):
+
+    settings        IdentifySettings: every option, checked          settings.py
+    limits          every tuned constant of the stages               limits.py
+    the recording   the twin's, a trace or a rig's recording         recording.py
+    prepare         grid, compared samples, weights, eq. 3           context.py (signals, weights, fitness)
+    1 search        the global search over [0, 1]^8                  search.py (optimizers, gwo, cmaes, problem)
+    2 polish        CMA-ES polish of the best point and runner-up    polish.py
+    3 final checks  the shorts' phases, a trapped eccentricity       checks.py
+      least squares the search's last polish; the fit measured       polish.py, search.py
+    4 second search the search again from another seed on a poor fit second_search.py
+    5 last stage    the monitor's bias corrected by a switching model last_stage.py
+    6 uncertainty   90 % intervals per fault                         uncertainty/
+    7 verdict       fits or not, warnings, the faults present        verdict.py (detection, coverage)
+    the result      IdentificationResult and its record              result.py
+
+The entry points are also re-exported by the top-level package (``emaphm.identify``,
+``emaphm.FaultIdentifier``, ``emaphm.IdentifySettings``). Names load on first use (PEP 562).
 """
 
-from .metrics import absolute_errors, percent_error
-from .signals import CUTOFF_HZ, Comparison, lowpass, nrmse
+from __future__ import annotations
 
-__all__ = ["CUTOFF_HZ", "Comparison", "absolute_errors", "lowpass", "nrmse", "percent_error"]
+import importlib
+from typing import Any
+
+__all__ = [
+    "CUTOFF_HZ",
+    "Comparison",
+    "FaultIdentifier",
+    "IdentificationResult",
+    "IdentifySettings",
+    "absolute_errors",
+    "identify",
+    "lowpass",
+    "nrmse",
+    "percent_error",
+]
+
+_WHERE = {
+    "CUTOFF_HZ": "signals", "Comparison": "signals", "lowpass": "signals", "nrmse": "signals",
+    "absolute_errors": "metrics", "percent_error": "metrics", "FaultIdentifier": "identifier",
+    "IdentificationResult": "result", "IdentifySettings": "settings", "identify": "api",
+}  # fmt: skip
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -56,7 +56,7 @@ def collect_cases(
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
     "raw_std"} arrays (one row per case). The draws do not depend on `cases`, so a longer set
     extends a shorter one, and `first` resumes one."""
-    from .identify import identify
+    from .api import identify
 
     K = random_faults(cases, seed, absent=absent)[first:]
     estimates, raw, walls = np.empty_like(K), np.empty_like(K), []
@@ -89,8 +89,8 @@ def calibrate_uq(
 
     `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
     """
-    from .identify import resolve_error_corner
-    from .switching import resolve_last_stage
+    from .last_stage import resolve_last_stage
+    from .weights import resolve_error_corner
 
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:

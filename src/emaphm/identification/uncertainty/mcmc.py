@@ -29,12 +29,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..faults import FAULT_NAMES
-from .uncertainty import PHASE, Z90, ZETA, Factors, Uncertainty, to_cartesian, to_faults
+from ...errors import InputError
+from ...faults import FAULT_NAMES
+from .factors import Factors
+from .intervals import PHASE, Z90, ZETA, Uncertainty, to_cartesian, to_faults
 
 if TYPE_CHECKING:
-    from .identify import FaultIdentifier
+    from ...models import MonitorEma
+    from ..fitness import Fitness
 
 __all__ = ["CHUNK", "MAX_STEPS", "WALKERS", "check_emcee", "sample"]
 
@@ -54,9 +56,12 @@ def check_emcee() -> None:
 
 
 def sample(
-    ident: FaultIdentifier,
+    objective: Fitness,
+    monitor: MonitorEma,
+    k_hat: NDArray[np.float64],
     local: Uncertainty,
     *,
+    duration: float,
     factors: Factors,
     seed: int,
     walkers: int = WALKERS,
@@ -64,20 +69,19 @@ def sample(
     max_steps: int | None = None,
     on_step: Callable[[int, int, float], None] | None = None,
 ) -> Uncertainty:
-    """Posterior intervals about a fitted `FaultIdentifier` (module docstring); `local` is its
-    Laplace result (τ, s², Cov). `on_step(−steps, max_steps, nan)` reports progress (negative:
+    """Posterior intervals about the estimate `k_hat` of eq. 3 `objective` of `monitor` over
+    `duration` [s] (module docstring); `local` is its Laplace result (τ, s², Cov). `on_step(−steps, max_steps, nan)` reports progress (negative:
     MCMC steps, not generations). Reproducible: walkers and moves are drawn from `seed`."""
     import emcee
 
     check_emcee()
     chunk = CHUNK if chunk is None else chunk  # the module's values at call time
     max_steps = MAX_STEPS if max_steps is None else max_steps
-    u0 = to_cartesian(ident.faults_)[0]
+    u0 = to_cartesian(k_hat)[0]
     tau_r, s2 = float(local.details["residual_tau"]), float(local.details["s2"])
     temper = 2.0 * tau_r * s2
     if not (np.isfinite(temper) and temper > 0):
         raise InputError("the residual at the estimate is zero: no likelihood to sample")
-    monitor, duration, objective = ident.monitor_, ident.duration_, ident.final_objective_
     evaluations = [0]
 
     def log_prob(U: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -91,14 +95,7 @@ def sample(
             out[inside] = np.where(np.isfinite(f), -f / temper, -np.inf)
         return out
 
-    rng = np.random.default_rng(seed)
-    cov = local.cov_u if local.cov_u is not None else np.diag(np.full(8, 1e-6))
-    cov = 0.25 * (cov + cov.T) / 2 + np.eye(8) * 1e-12
-    p0 = rng.multivariate_normal(u0, cov, size=walkers, method="eigh")
-    keep = np.delete(np.arange(8), [ZETA, PHASE])
-    p0[:, keep] = np.clip(p0[:, keep], 1e-9, 1.0 - 1e-9)
-    rho = np.hypot(p0[:, ZETA], p0[:, PHASE])
-    p0[:, [ZETA, PHASE]] /= np.maximum(rho / 0.999, 1.0)[:, None]
+    p0 = _start(u0, local, np.random.default_rng(seed), walkers)
     # differential-evolution moves: on the Table 1 case (2000 steps, 32 walkers) they halved the
     # autocorrelation times of the default stretch move (46-66 steps against 89-132), with the same
     # intervals to 0.003
@@ -134,6 +131,20 @@ def sample(
         "acceptance": round(float(np.mean(sampler.acceptance_fraction)), 3), "seed": seed,
         "residual_tau": tau_r, "s2": s2,
     }, evaluations=local.evaluations + evaluations[0])  # fmt: skip
+
+
+def _start(
+    u0: NDArray[np.float64], local: Uncertainty, rng: np.random.Generator, walkers: int
+) -> NDArray[np.float64]:
+    """The walkers' start: N(û, Cov_Laplace/4), inside the box and the disc ζ ≤ 1."""
+    cov = local.cov_u if local.cov_u is not None else np.diag(np.full(8, 1e-6))
+    cov = 0.25 * (cov + cov.T) / 2 + np.eye(8) * 1e-12
+    p0 = rng.multivariate_normal(u0, cov, size=walkers, method="eigh")
+    keep = np.delete(np.arange(8), [ZETA, PHASE])
+    p0[:, keep] = np.clip(p0[:, keep], 1e-9, 1.0 - 1e-9)
+    rho = np.hypot(p0[:, ZETA], p0[:, PHASE])
+    p0[:, [ZETA, PHASE]] /= np.maximum(rho / 0.999, 1.0)[:, None]
+    return p0  # type: ignore[no-any-return]
 
 
 def summarise(

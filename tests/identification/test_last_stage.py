@@ -8,19 +8,22 @@ import pytest
 import emaphm
 from emaphm import InputError
 from emaphm.commands import Chirp
-from emaphm.identification import optimizers
-from emaphm.identification import switching as switching_module
+from emaphm.identification import limits, optimizers
+from emaphm.identification import polish as polish_module
+from emaphm.identification.api import identify
 from emaphm.identification.fitness import Fitness
-from emaphm.identification.identify import FaultIdentifier, identify
-from emaphm.identification.signals import Comparison
-from emaphm.identification.switching import (
-    SWITCHING_STEPS,
+from emaphm.identification.identifier import FaultIdentifier
+from emaphm.identification.last_stage import (
     SwitchingModel,
     resolve_last_stage,
     space_mapping,
+    switching_steps,
 )
+from emaphm.identification.signals import Comparison
 from emaphm.models import HighFidelityEma
 from emaphm.params import EmaParams
+
+PAPER_STEPS = (2e-6, 2.5e-6, 1.25e-6)  # the steps measured for the paper's actuator (1 us, 10 kHz)
 
 F_S = 10_000.0
 N = 2000
@@ -61,7 +64,7 @@ def _oracle(bias_slope: float):
         return residuals
 
     # the monitor's own least-squares fit: biased by b
-    x0 = optimizers.least_squares_polish(
+    x0 = polish_module.least_squares_polish(
         residuals_of(objective), optimizers.OptimizerRun(np.full(4, 0.5), np.inf, 0, [])
     ).x
     return objective, residuals_of, monitor, switching, x0, truth
@@ -138,7 +141,7 @@ def test_the_switching_model_is_the_mean_of_the_twin_at_its_steps_on_any_number_
     np.testing.assert_array_equal(alone, np.mean(runs, axis=0))
     np.testing.assert_array_equal(model.current(k, duration=0.1, workers=2), alone)
     assert not np.array_equal(runs[0], runs[1])  # two different discretisations
-    assert SwitchingModel(EmaParams(), Chirp()).steps == SWITCHING_STEPS
+    assert SwitchingModel(EmaParams(), Chirp()).steps == PAPER_STEPS
     with pytest.raises(InputError):
         SwitchingModel(EmaParams(), Chirp(), steps=())
     with pytest.raises(InputError):  # a step that is not a whole fraction of the sample period
@@ -150,7 +153,7 @@ def test_the_last_stage_setting():
     assert resolve_last_stage("auto", "paper") == "none"  # the paper's method as published
     assert resolve_last_stage("switching", "paper") == "switching"
     assert resolve_last_stage("none", "default") == "none"
-    assert resolve_last_stage("switching", "default", local_polish=False) == "none"  # a raw search
+    assert resolve_last_stage("switching", "default", polish=False) == "none"  # a raw search
     with pytest.raises(InputError, match="last stage"):
         resolve_last_stage("fast", "default")
     with pytest.raises(InputError, match="last stage"):
@@ -164,7 +167,7 @@ BUDGET = {"pop_size": 16, "generations": 3}
 
 @pytest.fixture
 def tiny_polish(monkeypatch):
-    monkeypatch.setattr(optimizers, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
 
 
 @pytest.fixture(scope="module")
@@ -179,9 +182,9 @@ def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, 
     plain = FaultIdentifier(seed=2, last_stage="none", **BUDGET).fit(
         trace.t, trace.i_q, Chirp(), trace.theta_u
     )
-    record = ident.switching_
-    assert ident.last_stage_ == "switching" and record["steps_s"] == list(SWITCHING_STEPS)
-    assert record["iterations"] == switching_module.SWITCHING_ITERATIONS and record["history"][0] > 0
+    record = ident.record("last_stage")["switching"]
+    assert ident.last_stage_ == "switching" and record["steps_s"] == list(PAPER_STEPS)
+    assert record["iterations"] == limits.SWITCHING_ITERATIONS and record["history"][0] > 0
     # the same search, then the stage: the switching model fits its estimate no worse than the search's
     assert record["fitness"] <= record["start_fitness"]
     # and the search's own fitness is kept apart: the monitor's eq. 3 at the search's estimate
@@ -196,7 +199,7 @@ def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, 
         assert ident.final_objective_ is not ident.objective_
         assert not np.array_equal(ident.faults_, plain.faults_)
     assert (
-        plain.switching_ is None
+        plain.record("last_stage")["switching"] is None
         and plain.last_stage_ == "none"
         and plain.final_objective_ is plain.objective_
     )
@@ -204,10 +207,10 @@ def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, 
 
 def test_no_stage_without_the_polish_or_with_the_papers_monitor(two_shorts, tiny_polish):
     k, trace = two_shorts
-    raw = FaultIdentifier(seed=2, local_polish=False, **BUDGET).fit(trace.t, trace.i_q, Chirp())
-    assert raw.last_stage_ == "none" and raw.switching_ is None
+    raw = FaultIdentifier(seed=2, polish=False, **BUDGET).fit(trace.t, trace.i_q, Chirp())
+    assert raw.last_stage_ == "none" and raw.record("last_stage")["switching"] is None
     res = identify(k, seed=2, monitor="paper", uncertainty="none", **BUDGET)
-    assert res.settings["last_stage"] == "none" and res.settings["switching_stage"] is None
+    assert res.settings["last_stage"] == "none" and res.stage("last_stage")["switching"] is None
 
 
 def test_a_switching_model_that_diverges_leaves_the_searchs_estimate(two_shorts, tiny_polish, monkeypatch):
@@ -216,5 +219,26 @@ def test_a_switching_model_that_diverges_leaves_the_searchs_estimate(two_shorts,
     ident = FaultIdentifier(seed=2, **BUDGET).fit(trace.t, trace.i_q, Chirp())
     plain = FaultIdentifier(seed=2, last_stage="none", **BUDGET).fit(trace.t, trace.i_q, Chirp())
     np.testing.assert_array_equal(ident.faults_, plain.faults_)
-    assert ident.switching_["taken"] is False and "diverged" in ident.switching_["error"]
+    record = ident.record("last_stage")["switching"]
+    assert record["taken"] is False and "diverged" in record["error"]
     assert ident.fit_nrmse_ == plain.fit_nrmse_
+
+
+@pytest.mark.parametrize(("f_s", "dt"), [(8000.0, 1e-6), (40000.0, 1e-6), (10000.0, 2e-6), (12500.0, 1e-6)])
+def test_the_switching_steps_follow_the_actuators_own_step_and_rate(f_s, dt):
+    # review M1: fixed 2, 2.5, 1.25 us steps refused an 8 kHz actuator (62.5 steps per sample)
+    # after the whole search; the steps are now whole fractions of its own sample period
+    base = EmaParams()
+    params = dataclasses.replace(
+        base,
+        controller=dataclasses.replace(base.controller, f_s=f_s),
+        integration=dataclasses.replace(base.integration, dt=dt),
+    )
+    steps = switching_steps(params)
+    period = 1.0 / f_s
+    for step, factor in zip(steps, limits.SWITCHING_STEP_FACTORS, strict=True):
+        n = period / step
+        assert n == pytest.approx(round(n), abs=1e-9) and round(n) >= 1  # a whole number of steps per sample
+        assert step == pytest.approx(factor * dt, rel=0.25)  # near the factor asked for
+    assert SwitchingModel(params, Chirp()).steps == steps  # EmaParams accepts every one of them
+    assert switching_steps(EmaParams()) == PAPER_STEPS

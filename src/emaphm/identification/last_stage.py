@@ -1,4 +1,4 @@
-"""The switching last stage of an identification (issue 8): the monitor's bias corrected by a switching model.
+"""Stage 5, the last stage (issue 8): the monitor's bias corrected by a switching model of the drive.
 
 The averaged monitor errs at the truth like a twin with a 1 % torque error (LF-vs-HF NRMSE median
 1.8 %, 7 in 1000 random cases above 4 %; docs/theory/monitor-model.md §4), and that bias, not the
@@ -13,8 +13,8 @@ mapping:
     k_(j+1) = argmin_k  Σ w · (I_ref − F(I_LF(k)) − d̄_j)²    (eq. 3 of the corrected monitor)
 
 with F the comparison filter, I_S the switching model's current (`SwitchingModel`: the mean of its
-runs at `SWITCHING_STEPS`), w eq. 3's weights and each argmin a least-squares polish of the
-monitor from k_j (`optimizers.least_squares_polish`). d is the monitor's error near the estimate;
+runs at `switching_steps`), w eq. 3's weights and each argmin a least-squares polish of the
+monitor from k_j (`polish.least_squares_polish`). d is the monitor's error near the estimate;
 where it changes slowly with k, the fixed point is where the switching model fits the measurement
 with the monitor's sensitivities (where those mislead, the fixed point is elsewhere: docs/
 identification.md §6). Averaging d over the iterations (and I_S over the steps) keeps
@@ -23,7 +23,7 @@ discretisation's current fitted that realisation instead of the faults (BENCHMAR
 switching last stage, measured and not built").
 
 Each iteration costs one switching evaluation (one twin run per step, side by side on threads)
-and one least-squares polish of the monitor; `SWITCHING_ITERATIONS` of them, after one at the
+and one least-squares polish of the monitor; `limits.SWITCHING_ITERATIONS` of them, after one at the
 search's estimate. The final estimate is the iterate the switching model fits best (eq. 3), the
 search's estimate among them: where that one fits best, it stands (`SwitchingStage.taken`).
 """
@@ -44,41 +44,46 @@ from ..commands import Command
 from ..errors import InputError, SimulationError
 from ..models import HighFidelityEma
 from ..params import EmaParams
+from . import limits
+from .context import Context
 from .fitness import Fitness
-from .optimizers import OptimizerRun, least_squares_polish
+from .optimizers import OptimizerRun
+from .polish import least_squares_polish
+from .problem import recentre_phase, search_to_faults
 from .signals import nrmse
+from .state import Record, State
 
 __all__ = [
     "LAST_STAGES",
-    "SWITCHING_ITERATIONS",
-    "SWITCHING_STEPS",
     "SwitchingModel",
     "SwitchingStage",
-    "check_last_stage",
+    "last_stage",
     "resolve_last_stage",
     "space_mapping",
+    "switching_steps",
 ]
 
-# the switching model's integration steps [s]: the twin's drive at steps other than its own 1 µs,
-# each a whole fraction of the 100 µs sample period (`EmaParams`); its current is their runs' mean
-SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)
-# output-space-mapping iterations (each: one switching evaluation, one least-squares polish)
-SWITCHING_ITERATIONS = 3
+
+def switching_steps(params: EmaParams) -> tuple[float, ...]:
+    """The switching model's integration steps [s] for an actuator: `limits.SWITCHING_STEP_FACTORS`
+    times its own step dt, each rounded to the nearest whole fraction 1/(n·f_s) of its sample
+    period (`EmaParams` needs a whole number of steps per sample): 2, 2.5 and 1.25 µs at the
+    paper's 1 µs and 10 kHz; 2.016, 2.5 and 1.25 µs at 8 kHz."""
+    period = 1.0 / params.controller.f_s
+    steps = []
+    for factor in limits.SWITCHING_STEP_FACTORS:
+        n = max(1, round(period / (factor * params.integration.dt)))
+        steps.append(period / n)
+    return tuple(steps)
 
 
-def check_last_stage(value: str) -> str:
-    """`value` if it is one of `LAST_STAGES`, else `InputError`."""
-    if value not in LAST_STAGES:
-        raise InputError(f"unknown last stage {value!r}; use one of {', '.join(LAST_STAGES)}")
-    return value
-
-
-def resolve_last_stage(value: str, monitor: str, *, local_polish: bool = True) -> str:
+def resolve_last_stage(value: str, monitor: str, *, polish: bool = True) -> str:
     """The last stage an identification runs ("switching" or "none") for a `LAST_STAGES` setting;
     "auto" gives the switching stage with the default monitor, none with the paper's. Without the
     polish none runs: a raw search stays raw."""
-    check_last_stage(value)
-    if not local_polish:
+    if value not in LAST_STAGES:
+        raise InputError(f"unknown last stage {value!r}; use one of {', '.join(LAST_STAGES)}")
+    if not polish:
         return "none"
     if value == "auto":
         return "switching" if monitor == "default" else "none"
@@ -86,11 +91,12 @@ def resolve_last_stage(value: str, monitor: str, *, local_polish: bool = True) -
 
 
 class SwitchingModel:
-    """The twin's switching drive at other integration steps (`SWITCHING_STEPS`); its current is
-    the mean of one noise-free run at each step, the runs side by side on `workers` threads (the
-    twin's kernel releases the GIL)."""
+    """The twin's switching drive at other integration steps (default: `switching_steps` of the
+    actuator); its current is the mean of one noise-free run at each step, the runs side by side on
+    `workers` threads (the twin's kernel releases the GIL)."""
 
-    def __init__(self, params: EmaParams, command: Command, steps: Sequence[float] = SWITCHING_STEPS) -> None:
+    def __init__(self, params: EmaParams, command: Command, steps: Sequence[float] | None = None) -> None:
+        steps = switching_steps(params) if steps is None else steps
         if not steps:
             raise InputError("the switching model needs at least one integration step")
         self.steps = tuple(float(s) for s in steps)
@@ -168,17 +174,18 @@ def space_mapping(
     to_faults: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     x0: NDArray[np.float64],
     *,
-    iterations: int = SWITCHING_ITERATIONS,
+    iterations: int | None = None,
 ) -> SwitchingStage:
     """Output space mapping from the search's point x0 (in the search box; module docstring).
 
     `objective` is eq. 3 against the measurement; `residuals_of(fitness)` gives eq. 3's residual
-    vectors for rows of the box under another `Fitness` (`FaultIdentifier.residuals`);
+    vectors for rows of the box under another `Fitness` (`Context.residuals`);
     `monitor_current(k)` and `switching_current(k)` the two models' unfiltered currents for one
     fault vector k; `to_faults` maps rows of the box to fault rows (`search_to_faults`).
     A switching run that diverges ends the iterations; the best iterate so far is taken. A
     switching run at x0 that diverges raises `SimulationError`.
     """
+    iterations = limits.SWITCHING_ITERATIONS if iterations is None else iterations
     if iterations < 1:
         raise InputError(f"the switching stage needs at least one iteration, got {iterations}")
     keep = objective.weights > 0
@@ -215,3 +222,32 @@ def space_mapping(
     fitted = objective.reference.filtered(current)
     fit_nrmse = float(nrmse(objective.reference.reference[keep], fitted[keep]))
     return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history)
+
+
+def last_stage(state: State | None, context: Context) -> tuple[State, Record]:
+    """Stage 5: the settings' last stage (`resolve_last_stage`); the switching one runs from the
+    search's point (k7 recentred) when the fit explains the measurement, and sets the final point,
+    eq. 3, fit and the corrected eq. 3 for the intervals to the switching model's (`space_mapping`)."""
+    import numba
+
+    assert state is not None
+    s, monitor, duration = context.settings, context.monitor, context.duration
+    resolved = resolve_last_stage(s.last_stage, monitor.monitor, polish=s.polish)
+    record: Record = {"stage": "last_stage", "last_stage": resolved, "switching": None}
+    if resolved != "switching" or not state.fit_nrmse <= limits.FIT_NRMSE_LIMIT:
+        return state, record
+    x0 = recentre_phase(state.run).x
+    model = SwitchingModel(monitor.params, monitor.command)
+    workers = numba.get_num_threads()
+    try:
+        stage = space_mapping(
+            context.objective, context.residuals, lambda k: monitor.simulate(k, duration=duration).i_q,
+            lambda k: model.current(k, duration=duration, workers=workers), search_to_faults, x0,
+        )  # fmt: skip
+    except SimulationError as exc:  # the switching model diverged at the search's estimate
+        record["switching"] = {"steps_s": list(model.steps), "taken": False, "error": str(exc)}
+        return dataclasses.replace(state, x=x0), record
+    record["switching"] = stage.record(model.steps)
+    run = dataclasses.replace(state.run, evaluations=state.run.evaluations + stage.evaluations)
+    fitted = context.reference.filtered(stage.current)
+    return State(run, stage.fit_nrmse, fitted, stage.x, stage.fitness, stage.objective), record
