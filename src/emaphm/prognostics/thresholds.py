@@ -21,7 +21,7 @@ while its metric stays below the limit:
   geometric, so the backlash threshold is solved in closed form, (limit/B0 − 1)/99, without a
   simulation; a limit beyond k2 = 1 gives no threshold, one at or below B0 is refused.
 
-Angles take the units of `emaphm.actuator.UNITS` (``"0.5 deg"``, ``"2 mrad"``, ``"30 arcmin"``),
+Angles take the units of `emaphm.units.UNITS` (``"0.5 deg"``, ``"2 mrad"``, ``"30 arcmin"``),
 currents ``"8 A"`` or ``"8000 mA"``; a bare number is SI.
 
 The search, per fault: the metrics on a grid of `GRID_POINTS` distances over the fault's range
@@ -50,11 +50,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._version import __version__
-from ..actuator import _QUANTITY, UNITS, _normalise_unit, _value, resolve_params
+from ..actuator import resolve_params
 from ..commands import Chirp, Command, command_record, make_command
 from ..errors import InputError
 from ..faults import HEALTHY, apply_faults
 from ..params import EmaParams
+from ..units import UNITS, parameter_units, split_quantity, to_si
 from .rul import FAULTS, PLACEHOLDER_THRESHOLDS
 
 __all__ = [
@@ -111,9 +112,9 @@ class Requirement:
                 f"requirement {self.kind}: the limit must be a finite number > 0, got {self.limit!r}"
             )
         si = self.si_unit
-        if self.unit and self.unit not in UNITS[si]:
+        if self.unit and self.unit not in parameter_units(si):
             raise InputError(
-                f"requirement {self.kind}: unit {self.unit!r} is not one of {', '.join(UNITS[si])}"
+                f"requirement {self.kind}: unit {self.unit!r} is not one of {', '.join(parameter_units(si))}"
             )
         object.__setattr__(self, "limit", float(self.limit))
         object.__setattr__(self, "unit", self.unit or si)
@@ -187,11 +188,11 @@ def parse_requirement(text: str, *, params: EmaParams | None = None, where: str 
             raise InputError(f"{where}: current = {raw!r}: the fraction of I_max must be > 0")
         req = Requirement(kind, fraction, raw, "A", of_I_max=fraction)
         return req.resolve(params if params is not None else EmaParams())
-    value = float(_value(raw, kind, si, where))
+    value = float(to_si(raw, kind, si, where))
     if not (math.isfinite(value) and value > 0):
         raise InputError(f"{where}: {kind} = {raw!r}: the limit must be a finite number > 0")
-    match = _QUANTITY.match(raw)  # _value parsed it: a number, then a unit of the kind or none
-    unit = _normalise_unit(match.group(2)) if match is not None and match.group(2) else si
+    parsed = split_quantity(raw)  # to_si parsed it: a number, then a unit of the kind or none
+    unit = parsed[1] if parsed is not None and parsed[1] else si
     req = Requirement(kind, value, raw, unit)
     return req.resolve(params) if params is not None else req
 
