@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import InputError
+from .failure import parse_thresholds
 from .params import EmaParams
 from .units import parameter_units, to_si
 
@@ -178,7 +179,6 @@ def load_thresholds(path: str | os.PathLike[str]) -> dict[str, float]:
     """The ``[thresholds]`` table of an actuator file: failure thresholds per fault, as distances
     from healthy in fault units (``friction = 0.45``); {} when the file has none."""
     from .io import read_toml
-    from .prognostics.rul import parse_thresholds
 
     p = Path(path)
     load_params(p)  # the whole file is valid

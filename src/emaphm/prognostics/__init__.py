@@ -19,7 +19,8 @@ lines; docs/prognostics.md the guide.
 
 from __future__ import annotations
 
-from .rul import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds, rul_report
+from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds
+from .rul import rul_report
 from .thresholds import REQUIREMENT_KINDS, Requirement, derive_thresholds, parse_requirement, thresholds_toml
 from .trend import LAWS, DegradationTrend, RulEstimate
 

@@ -53,10 +53,10 @@ from .._version import __version__
 from ..actuator import resolve_params
 from ..commands import Chirp, Command, command_record, make_command
 from ..errors import InputError
+from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS
 from ..faults import HEALTHY, apply_faults
 from ..params import EmaParams
 from ..units import UNITS, parameter_units, split_quantity, to_si
-from .rul import FAULTS, PLACEHOLDER_THRESHOLDS
 
 __all__ = [
     "ECCENTRICITY_PHASES",
