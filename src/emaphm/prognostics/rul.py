@@ -138,10 +138,42 @@ def rul_report(
         if not rows:
             raise InputError(f"actuator {actuator!r} has no flight at or before {at_flight}")
     t_now = float(at_flight if at_flight is not None else rows[-1]["flight"])
-    given = dict(thresholds or {})
-    faults: dict[str, Any] = {}
+    faults, tracked = _tracked(rows, dict(thresholds or {}))
     trends: dict[str, Any] = {}
     estimates: dict[str, RulEstimate] = {}
+    # the faults' trends drawn together: estimates of one identification are correlated (its
+    # corr), and so are the trends fitted to them; this matters for the first failure
+    drawn = list(tracked)
+    rho = _correlations(rows, drawn) if drawn else np.eye(0)
+    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
+    for i, name in enumerate(drawn):
+        trend, threshold, entry = tracked[name]
+        assert normals is not None
+        if estimator == "ukf":
+            model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
+            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
+            trends[name] = progpy_model.UkfTrend(trend, ukf)
+        else:
+            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
+            trends[name] = trend
+        estimates[name] = est
+        faults[name] = {**entry, "status": "tracked", **est.to_json(),
+                        "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
+    faults = {name: faults[name] for name in FAULTS}  # in the order of FAULTS
+    first = _first_failure(estimates, drawn, rho, faults, t_now, inspection_interval)
+    return {
+        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
+        "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
+        "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
+    }  # fmt: skip
+
+
+def _tracked(
+    rows: list[dict[str, Any]], given: dict[str, float]
+) -> tuple[dict[str, Any], dict[str, tuple[DegradationTrend, float, dict[str, Any]]]]:
+    """Each fault's entry of the report when it cannot be tracked (not detected, or too few
+    measurements), and the trend, threshold and entry of each one that can."""
+    faults: dict[str, Any] = {}
     tracked: dict[str, tuple[DegradationTrend, float, dict[str, Any]]] = {}
     for name, (_, law, healthy) in FAULTS.items():
         threshold = given.get(name, PLACEHOLDER_THRESHOLDS[name])
@@ -162,25 +194,19 @@ def rul_report(
             faults[name] = {**entry, "status": "too few measurements", **_NO_RUL}
             continue
         tracked[name] = (trend, threshold, entry)
-    # the faults' trends drawn together: estimates of one identification are correlated (its
-    # corr), and so are the trends fitted to them; this matters for the first failure
-    drawn = list(tracked)
-    rho = _correlations(rows, drawn) if drawn else np.eye(0)
-    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
-    for i, name in enumerate(drawn):
-        trend, threshold, entry = tracked[name]
-        assert normals is not None
-        if estimator == "ukf":
-            model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
-            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
-            trends[name] = progpy_model.UkfTrend(trend, ukf)
-        else:
-            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
-            trends[name] = trend
-        estimates[name] = est
-        faults[name] = {**entry, "status": "tracked", **est.to_json(),
-                        "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
-    faults = {name: faults[name] for name in FAULTS}  # in the order of FAULTS
+    return faults, tracked
+
+
+def _first_failure(
+    estimates: dict[str, RulEstimate],
+    drawn: list[str],
+    rho: NDArray[np.float64],
+    faults: dict[str, Any],
+    t_now: float,
+    inspection_interval: float,
+) -> dict[str, Any]:
+    """The RUL of the first failure (the earliest crossing of each joint draw), added to
+    `estimates` as "first failure"."""
     first: dict[str, Any] = {"status": "no fault tracked"}
     if estimates:
         stacked = np.vstack([e.samples for e in estimates.values()])
@@ -196,8 +222,4 @@ def rul_report(
             "placeholder_thresholds": sorted(n for n in estimates if faults[n]["placeholder"]),
         }  # fmt: skip
         estimates["first failure"] = est
-    return {
-        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
-        "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
-        "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
-    }  # fmt: skip
+    return first

@@ -131,17 +131,11 @@ def derive_thresholds(
     if progress is not None and twin.total:
         progress(twin.total, twin.total)
     return {
-        "requirements": [r.to_json() for r in reqs],
-        "command": command_record(cmd),
-        "params_hash": params_hash(actuator),
-        "resolution": float(resolution),
-        "healthy": healthy,
-        "faults": results,
-        "warnings": warnings,
-        "simulations": twin.simulations,
-        "wall_time_s": round(time.perf_counter() - start, 3),
-        "version": __version__,
-    }
+        "requirements": [r.to_json() for r in reqs], "command": command_record(cmd),
+        "params_hash": params_hash(actuator), "resolution": float(resolution), "healthy": healthy,
+        "faults": results, "warnings": warnings, "simulations": twin.simulations,
+        "wall_time_s": round(time.perf_counter() - start, 3), "version": __version__,
+    }  # fmt: skip
 
 
 def _fault_names(faults: Sequence[str] | str | None) -> list[str]:
