@@ -134,7 +134,7 @@ def _targets(module: str, is_package: bool, stmt: ast.Import | ast.ImportFrom, k
             stem = stmt.module or ""
         names = [stem]
         names += [f"{stem}.{alias.name}" for alias in stmt.names if f"{stem}.{alias.name}" in known]
-    out = set()
+    out: set[str] = set()
     for name in names:
         out.update(n for n in _with_parents(name) if n in known)
     return out
