@@ -19,7 +19,7 @@ from emaphm.prognostics import (
     parse_requirement,
     thresholds_toml,
 )
-from emaphm.prognostics.thresholds import _monotone
+from emaphm.prognostics.threshold_search import check_monotone
 from tests.helpers import run_cli
 
 DEG = math.pi / 180.0
@@ -173,9 +173,13 @@ def test_the_toml_table_reads_back_through_load_thresholds():
 def test_a_fall_of_a_metric_on_the_grid_is_a_warning():
     req = Requirement("tracking", 0.1)
     warnings: list[str] = []
-    flags = _monotone("eccentricity", [0.0, 0.5, 1.0], [req], {"tracking": [0.02, 0.03, 0.025]}, warnings)
+    flags = check_monotone(
+        "eccentricity", [0.0, 0.5, 1.0], [req], {"tracking": [0.02, 0.03, 0.025]}, warnings
+    )
     assert flags == {"tracking": False} and "eccentricity: tracking is not monotone" in warnings[0]
-    assert _monotone("friction", [0.0, 0.5], [req], {"tracking": [0.02, 0.01999]}, []) == {"tracking": True}
+    assert check_monotone("friction", [0.0, 0.5], [req], {"tracking": [0.02, 0.01999]}, []) == {
+        "tracking": True
+    }
 
 
 def test_cli_thresholds_writes_a_table_and_refuses_bad_input(tmp_path, capsys):

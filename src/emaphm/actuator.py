@@ -5,8 +5,8 @@
 ``[integration]``), each parameter keyed by its name in `emaphm.params` (``R_s = 0.5``) with its
 unit and meaning as a comment. ``--params FILE`` (``params=`` in the API) reads it back:
 
-- a value is a number in the SI unit of the comment, or a string with a unit from a closed
-  table: ``L_s = "1.5 mH"``, ``theta_max = "28.6 deg"``, ``I_max = "10000 mA"``;
+- a value is a number in the SI unit of the comment, or a string with a unit from the closed
+  table of `emaphm.units`: ``L_s = "1.5 mH"``, ``theta_max = "28.6 deg"``, ``I_max = "10000 mA"``;
 - a parameter left out keeps the paper's nominal value; a key may also stand at the top level
   (``R_s = 0.6``) and is then found in its block;
 - unknown tables or keys, a unit of another kind (``R_s = "1 mH"``), a value that fails its
@@ -20,44 +20,22 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import re
 from pathlib import Path
 from typing import Any
 
 from .errors import InputError
+from .failure import parse_thresholds
 from .params import EmaParams
+from .units import parameter_units, to_si
 
 __all__ = [
     "ACCEPTED",
-    "UNITS",
     "load_params",
     "load_thresholds",
     "params_from_dict",
     "params_template",
     "resolve_params",
 ]
-
-_DEG = math.pi / 180.0
-
-# every unit a value may carry, by the SI unit of its parameter (the field metadata's): factor to SI
-UNITS: dict[str, dict[str, float]] = {
-    "-": {"-": 1.0, "%": 0.01},
-    "Ω": {"Ω": 1.0, "ohm": 1.0, "mΩ": 1e-3, "mohm": 1e-3},
-    "H": {"H": 1.0, "mH": 1e-3, "µH": 1e-6, "uH": 1e-6},
-    "Wb": {"Wb": 1.0, "mWb": 1e-3, "V·s": 1.0},
-    "V": {"V": 1.0, "kV": 1e3},
-    "A": {"A": 1.0, "mA": 1e-3},
-    "kg·m²": {"kg·m²": 1.0, "kg·cm²": 1e-4, "g·cm²": 1e-7},
-    "N·m·s/rad": {"N·m·s/rad": 1.0, "mN·m·s/rad": 1e-3},
-    "N·m": {"N·m": 1.0, "Nm": 1.0, "mN·m": 1e-3, "mNm": 1e-3},
-    "rad": {"rad": 1.0, "mrad": 1e-3, "deg": _DEG, "°": _DEG, "arcmin": _DEG / 60.0},
-    "A/rad": {"A/rad": 1.0, "A/deg": 1.0 / _DEG},
-    "A/(rad·s)": {"A/(rad·s)": 1.0, "A/(deg·s)": 1.0 / _DEG},
-    "A·s/rad": {"A·s/rad": 1.0, "A·s/deg": 1.0 / _DEG},
-    "s": {"s": 1.0, "ms": 1e-3, "µs": 1e-6, "us": 1e-6, "ns": 1e-9},
-    "Hz": {"Hz": 1.0, "kHz": 1e3},
-    "bit": {"bit": 1.0, "bits": 1.0},
-}
 
 # the range emaphm accepts per parameter (SI): every EMA of flight controls fits, and a value given
 # in the wrong unit (mH as H, deg as rad, mA as A) falls out of it
@@ -74,8 +52,6 @@ ACCEPTED: dict[str, tuple[float, float]] = {
     "dt": (1e-8, 1e-3), "ripple_fraction": (0.01, 1.0),
 }  # fmt: skip
 
-_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
-
 
 def _groups() -> dict[str, type]:
     """Block name → parameter dataclass, in the order of `EmaParams`."""
@@ -85,33 +61,6 @@ def _groups() -> dict[str, type]:
 def _fields() -> dict[str, tuple[str, dataclasses.Field[Any]]]:
     """Parameter name → (block, field): the names are unique across blocks."""
     return {f.name: (group, f) for group, cls in _groups().items() for f in dataclasses.fields(cls)}
-
-
-def _normalise_unit(unit: str) -> str:
-    u = unit.strip().replace("μ", "µ").replace("*", "·").replace("^2", "²")
-    return re.sub(r"(?<=\w) (?=\w)", "·", u)  # "kg m²" -> "kg·m²"
-
-
-def _value(raw: Any, key: str, si_unit: str, where: str) -> float | int:
-    """The SI value of one entry: a number as it is, or a string "<number> <unit>"."""
-    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
-        raise InputError(f"{where}: {key} must be a number or a string with a unit, got {raw!r}")
-    if not isinstance(raw, str):
-        return raw
-    match = _QUANTITY.match(raw)
-    if match is None:
-        raise InputError(f'{where}: {key} = {raw!r} is not a number with a unit (e.g. "1.5 {si_unit}")')
-    number, unit = float(match.group(1)), _normalise_unit(match.group(2))
-    table = UNITS[si_unit]
-    if unit == "":
-        return number
-    if unit not in table:
-        raise InputError(
-            f"{where}: {key} = {raw!r}: unit {match.group(2)!r} is not one for {key} "
-            f"(its unit is {si_unit}; accepted: {', '.join(table)})"
-        )
-    # 12 significant digits: "1.8 mH" is 0.0018 H, not 0.0018000000000000002 (one actuator, one hash)
-    return float(f"{number * table[unit]:.12g}")
 
 
 def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaParams:
@@ -131,7 +80,7 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
             raise InputError(f"{where}: {key} is given twice ({seen[key]} and {block or 'top level'})")
         seen[key] = block or "top level"
         si_unit = f.metadata["unit"]
-        value = _value(raw, key, si_unit, where)
+        value = to_si(raw, key, si_unit, where)
         lo, hi = ACCEPTED[key]
         if not (isinstance(value, (int, float)) and math.isfinite(value)):
             raise InputError(f"{where}: {key} must be a finite number, got {raw!r}")
@@ -174,7 +123,7 @@ _LIKELY = {"rad": "deg", "A/rad": "A/deg", "A/(rad·s)": "A/(deg·s)", "A·s/rad
 def _example_unit(si_unit: str) -> str:
     if si_unit in _LIKELY:
         return _LIKELY[si_unit]
-    others = [u for u in UNITS[si_unit] if u != si_unit]
+    others = [u for u in parameter_units(si_unit) if u != si_unit]
     return others[0] if others else si_unit
 
 
@@ -230,7 +179,6 @@ def load_thresholds(path: str | os.PathLike[str]) -> dict[str, float]:
     """The ``[thresholds]`` table of an actuator file: failure thresholds per fault, as distances
     from healthy in fault units (``friction = 0.45``); {} when the file has none."""
     from .io import read_toml
-    from .prognostics.rul import parse_thresholds
 
     p = Path(path)
     load_params(p)  # the whole file is valid

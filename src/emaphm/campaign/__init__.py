@@ -2,6 +2,7 @@
 that survives interruption.
 
 - `spec`: the campaign file (TOML) and its jobs with stable content keys;
+- `actuators`: its ``[[actuator]]`` and ``[[fleet]]`` tables, histories grown flight by flight;
 - `jobs`: one job, run anywhere from plain data (`run_job`);
 - `store`: the Parquet results store, written atomically;
 - `runner`: `run_campaign` (the missing jobs only; Dask or serial) and `campaign_status`.

@@ -89,6 +89,34 @@ def run_campaign(
     spec = _spec(spec)
     store = ResultStore(out)
     jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work
+    address, cores, serial = _backend(scheduler, workers)
+    store.remove_temporaries()
+    done_keys = store.keys("results", spec.name)
+    todo = [j for j in jobs if j.key not in done_keys]
+    start = time.perf_counter()
+    collector = _Collector(store, len(todo), progress, flush_rows, flush_seconds, start)
+    n_workers = 1
+    backend = "serial"
+    ready = {"at": start}
+    try:
+        if progress is not None:
+            progress(0, 0, len(todo), 0.0)
+        if todo and serial:
+            _run_serial(todo, collector.finished)
+        elif todo:
+            backend, n_workers = _run_dask(todo, address, workers or cores, collector.finished, ready)
+    finally:
+        collector.flush(force=True)
+    return CampaignSummary(
+        campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo),
+        done=collector.done, failed=collector.failed, wall_time_s=round(time.perf_counter() - start, 3),
+        backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
+    )  # fmt: skip
+
+
+def _backend(scheduler: str | None, workers: int | None) -> tuple[str | None, int, bool]:
+    """The scheduler's address (None: a local cluster), this machine's cores, and whether the
+    jobs run in this process; `InputError` for a worker count the machine lacks, or no Dask."""
     address = scheduler if scheduler is not None else os.environ.get("DASK_SCHEDULER_ADDRESS") or None
     cores = _cores()
     if workers is not None and not 1 <= workers <= cores and address is None:
@@ -103,55 +131,60 @@ def run_campaign(
             raise InputError(
                 "campaigns on several cores run on Dask: pip install 'emaphm[cluster]' (or --workers 1)"
             ) from None
-    store.remove_temporaries()
-    done_keys = store.keys("results", spec.name)
-    todo = [j for j in jobs if j.key not in done_keys]
-    start = time.perf_counter()
-    rows: list[dict[str, Any]] = []
-    failures: list[dict[str, Any]] = []
-    counts = {"done": 0, "failed": 0}
-    last_flush = time.monotonic()
+    return address, cores, serial
 
-    def flush(force: bool = False) -> None:
-        nonlocal rows, failures, last_flush
-        if force or len(rows) + len(failures) >= flush_rows or time.monotonic() - last_flush >= flush_seconds:
-            store.write("results", rows)
-            store.write("failures", failures)
-            rows, failures, last_flush = [], [], time.monotonic()
 
-    def finished(row: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
+class _Collector:
+    """The rows and failures of a run, written to the store in batches (every `flush_rows` rows or
+    `flush_seconds`), counted, with the progress callback after each job."""
+
+    def __init__(
+        self,
+        store: ResultStore,
+        todo: int,
+        progress: Progress | None,
+        flush_rows: int,
+        flush_seconds: float,
+        start: float,
+    ) -> None:
+        self.store, self.todo, self.progress, self.start = store, todo, progress, start
+        self.flush_rows, self.flush_seconds = flush_rows, flush_seconds
+        self.rows: list[dict[str, Any]] = []
+        self.failures: list[dict[str, Any]] = []
+        self.done = 0
+        self.failed = 0
+        self.last_flush = time.monotonic()
+
+    def flush(self, force: bool = False) -> None:
+        if (
+            force
+            or len(self.rows) + len(self.failures) >= self.flush_rows
+            or time.monotonic() - self.last_flush >= self.flush_seconds
+        ):
+            self.store.write("results", self.rows)
+            self.store.write("failures", self.failures)
+            self.rows, self.failures, self.last_flush = [], [], time.monotonic()
+
+    def finished(self, row: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
         if row is not None:
-            rows.append(row)
-            counts["done"] += 1
+            self.rows.append(row)
+            self.done += 1
         if failure is not None:
-            failures.append(failure)
-            counts["failed"] += 1
-        flush()
-        if progress is not None:
-            progress(counts["done"], counts["failed"], len(todo), time.perf_counter() - start)
+            self.failures.append(failure)
+            self.failed += 1
+        self.flush()
+        if self.progress is not None:
+            self.progress(self.done, self.failed, self.todo, time.perf_counter() - self.start)
 
-    n_workers = 1
-    backend = "serial"
-    ready = {"at": start}
-    try:
-        if progress is not None:
-            progress(0, 0, len(todo), 0.0)
-        if todo and serial:
-            for job in todo:
-                payload = job.to_dict()
-                try:
-                    finished(run_job(payload), None)
-                except (InputError, ArithmeticError, RuntimeError, ValueError, OSError) as exc:
-                    finished(None, failure_row(payload, exc))
-        elif todo:
-            backend, n_workers = _run_dask(todo, address, workers or cores, finished, ready)
-    finally:
-        flush(force=True)
-    return CampaignSummary(
-        campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo),
-        done=counts["done"], failed=counts["failed"], wall_time_s=round(time.perf_counter() - start, 3),
-        backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
-    )  # fmt: skip
+
+def _run_serial(todo: list[Any], finished: Callable[[Any, Any], None]) -> None:
+    """The jobs one after the other in this process; a job that raises is a failure row."""
+    for job in todo:
+        payload = job.to_dict()
+        try:
+            finished(run_job(payload), None)
+        except (InputError, ArithmeticError, RuntimeError, ValueError, OSError) as exc:
+            finished(None, failure_row(payload, exc))
 
 
 def _run_dask(

@@ -32,10 +32,8 @@ from .checks import plausibility
 from .inspection import inspect_file
 from .measurement import Channel, Measurement, load_measurement
 from .reference import Reference, to_reference, write_reference
-from .units import UNIT_TABLE
 
 __all__ = [
-    "UNIT_TABLE",
     "Channel",
     "ChannelMap",
     "ChannelSpec",

@@ -109,6 +109,31 @@ def _rms(x: NDArray[np.float64]) -> float:
     return float(np.sqrt(np.mean(x * x)))
 
 
+def _zero_sequence(
+    i_a: NDArray[np.float64],
+    i_b: NDArray[np.float64],
+    i_c: NDArray[np.float64],
+    f_s: float,
+    report: dict[str, Any],
+    warnings: list[str],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Three measured phases with the zero sequence removed when it exceeds `ZERO_SEQUENCE_MAX`
+    of the phase RMS in the comparison band (recorded in `report`, warned in `warnings`)."""
+    i_0 = i_a + i_b + i_c
+    phase_rms = (_rms(i_a) + _rms(i_b) + _rms(i_c)) / 3.0
+    ratio = _rms(lowpass(i_0, f_s)) / phase_rms if phase_rms > 0 else 0.0
+    report["zero_sequence_ratio"] = ratio
+    report["zero_sequence_removed"] = bool(ratio > ZERO_SEQUENCE_MAX)
+    if ratio > ZERO_SEQUENCE_MAX:
+        warnings.append(
+            f"i_a + i_b + i_c has {100 * ratio:.1f} % of the phase RMS in the comparison band "
+            f"(more than {100 * ZERO_SEQUENCE_MAX:g} %): a current-sensor offset or a neutral path; "
+            "the zero sequence was removed"
+        )
+        i_a, i_b, i_c = i_a - i_0 / 3.0, i_b - i_0 / 3.0, i_c - i_0 / 3.0
+    return i_a, i_b, i_c
+
+
 def phases_to_iq(
     t: NDArray[np.float64],
     i_a: NDArray[np.float64],
@@ -141,18 +166,7 @@ def phases_to_iq(
         report["i_c"] = "reconstructed as -i_a - i_b"
     else:
         report["i_c"] = "measured"
-        i_0 = i_a + i_b + i_c
-        phase_rms = (_rms(i_a) + _rms(i_b) + _rms(i_c)) / 3.0
-        ratio = _rms(lowpass(i_0, f_s)) / phase_rms if phase_rms > 0 else 0.0
-        report["zero_sequence_ratio"] = ratio
-        report["zero_sequence_removed"] = bool(ratio > ZERO_SEQUENCE_MAX)
-        if ratio > ZERO_SEQUENCE_MAX:
-            warnings.append(
-                f"i_a + i_b + i_c has {100 * ratio:.1f} % of the phase RMS in the comparison band "
-                f"(more than {100 * ZERO_SEQUENCE_MAX:g} %): a current-sensor offset or a neutral path; "
-                "the zero sequence was removed"
-            )
-            i_a, i_b, i_c = i_a - i_0 / 3.0, i_b - i_0 / 3.0, i_c - i_0 / 3.0
+        i_a, i_b, i_c = _zero_sequence(i_a, i_b, i_c, f_s, report, warnings)
     i_alpha, i_beta = clarke(i_a, i_b, i_c)
     if offset is None:
         theta0, residual = estimate_offset(i_alpha, i_beta, theta_e)

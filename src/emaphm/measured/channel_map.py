@@ -21,7 +21,7 @@ Keys of a channel entry:
   whose elements carry a ``Name`` field (Paderborn's ``Y``), a path part selects the element by
   that name (``"Y/phase_current_1"``). When the file holds a single struct, paths may start
   inside it.
-- ``unit`` (required): from the closed table of `emaphm.measured.units`, of the channel's kind.
+- ``unit`` (required): from the closed table of `emaphm.units`, of the channel's kind.
 - ``scale``: multiplier applied before the unit conversion (counts, sensor gain, −1 to flip a
   sign); default 1.
 - ``fs`` [Hz] and ``t0`` [s]: a channel without a time column, sampled at t0 + k/fs.
@@ -43,10 +43,22 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-from .units import KIND_OF_ROLE, UNIT_TABLE, kind_of, units_of_kind
+from ..units import kind_of, units_of_kind
 
 __all__ = ["ROLES", "ChannelMap", "ChannelSpec"]
 
+# the physical kind of each channel a map may name (the signal names of emaphm.results.UNITS)
+KIND_OF_ROLE: dict[str, str] = {
+    "t": "time",
+    "theta_cmd": "angle",
+    "theta_u": "angle",
+    "i_q": "current",
+    "i_a": "current",
+    "i_b": "current",
+    "i_c": "current",
+    "theta_e": "angle",
+    "theta_m": "angle",
+}
 ROLES = tuple(KIND_OF_ROLE)
 ENTRY_KEYS = ("name", "unit", "scale", "fs", "t0", "time", "time_unit")
 TIME_ENTRY_KEYS = ("name", "unit", "scale")
@@ -59,7 +71,7 @@ class ChannelSpec:
     """One mapped channel.
 
     name : str  column or variable in the file (a ``/`` path for nested data)
-    unit : str  unit of the samples (after `scale`), from `emaphm.measured.units.UNIT_TABLE`
+    unit : str  unit of the samples (after `scale`), from `emaphm.units.CHANNEL_UNITS`
     scale : float  multiplier applied before the unit conversion [-]
     fs : float or None  sample rate when the channel has no time column [Hz]
     t0 : float  time of the first sample with `fs` [s]
@@ -167,7 +179,7 @@ def _number(value: Any, key: str, where: str) -> float:
 def _unit(value: Any, kind: str, key: str, where: str) -> str:
     if not isinstance(value, str):
         raise InputError(f"{where}: {key} must be a unit name (a string), got {value!r}")
-    if value not in UNIT_TABLE:
+    if kind_of(value) is None:
         raise InputError(
             f"{where}: unknown unit {value!r} in {key}; {kind} units: {', '.join(units_of_kind(kind))}"
         )

@@ -1,7 +1,7 @@
 """`load_measurement`: the mapped channels of a measured file, in SI, each on its own time axis.
 
 next-features §D.3 items 1–4 and 9. Each channel is read as stored, multiplied by its ``scale``
-and its unit's factor to SI (`emaphm.measured.units`), and given its time base (the channel's
+and its unit's factor to SI (`emaphm.units`), and given its time base (the channel's
 ``time`` column, its ``fs``/``t0``, its raster in the file, or the common ``t``; see
 `emaphm.measured.channel_map`). Time axes must be strictly increasing wherever they are finite
 (a duplicated or backward step is refused naming its row); NaN samples and gaps stay in the
@@ -21,9 +21,9 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..io import sha256_of
+from ..units import factor, kind_of
 from .channel_map import ChannelMap
 from .formats import Column, Source, open_source
-from .units import UNIT_TABLE, factor, kind_of
 
 __all__ = ["Channel", "Measurement", "load_measurement"]
 
@@ -208,7 +208,7 @@ def _time_of(
         n = len(col.values)
         return spec.t0 + np.arange(n) / spec.fs, f"fs = {spec.fs:g} Hz from t0 = {spec.t0:g} s", col.row
     if col.time is not None:
-        declared = col.time_unit if col.time_unit in UNIT_TABLE and kind_of(col.time_unit) == "time" else None
+        declared = col.time_unit if kind_of(col.time_unit) == "time" else None
         unit = spec.time_unit or declared or "s"
         return col.time * factor(unit), f"raster {col.raster!r} in {unit}", col.row
     if spec.time_unit is not None:

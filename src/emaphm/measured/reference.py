@@ -12,7 +12,7 @@ next-features §D.3–§D.4. The steps, each refusing with a one-line `InputErro
 4. **angle ratio** — the rotor angle must turn p·τ times the surface angle (`checks.angle_ratio`).
 5. **i_q** — mapped, or from the phase currents on *their own* grid (`emaphm.measured.alignment`:
    Clarke/Park of `kernels.transforms`, θ0 estimated, sign from the motion).
-6. **resampling** — every signal onto t_k = k/f_s from the segment's start with
+6. **resampling** (`emaphm.measured.grid`) — every signal onto t_k = k/f_s from the segment's start with
    `identification.signals.resample`: a source faster than the grid is low-passed on its own
    grid first (Butterworth order 8 at 0.4·f_s, zero phase; a jittered fast source is first
    interpolated onto a uniform grid at its own rate), slower ones are interpolated linearly
@@ -32,24 +32,20 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from .._version import __version__
 from ..errors import InputError
-from ..identification.signals import ANTI_ALIAS_ABOVE, ANTI_ALIAS_FRACTION, resample
 from ..params import EmaParams
 from ..results import SimResult
 from . import limits
-from .alignment import phases_to_iq
 from .checks import angle_ratio, plausibility, span_problems, value_problems
+from .grid import Run, cut_run, grid_signals
 from .measurement import Channel, Measurement
 from .timebase import clean_runs, common_segment
 
 __all__ = ["FAST_ROLES", "Reference", "to_reference", "write_reference"]
 
 FAST_ROLES = ("i_q", "i_a", "i_b", "i_c", "theta_e", "theta_m")
-_MARGIN = 0.05  # [s] of a run kept beyond the segment, so the filters' edge transients fall outside
-_UNIFORM = 1e-3  # relative step jitter below which a source counts as uniform (as `resample`)
 
 
 @dataclass(frozen=True)
@@ -93,118 +89,30 @@ def to_reference(
         raise InputError(f"f_s must be a positive number of Hz, got {f_s!r}")
     m = measurement
     src = m.source
-    cmap = m.channel_map
     channels = list(m.channels.values())
     warnings = list(m.warnings)
-    flags: list[str] = []
-
-    for ch in channels:  # 1. span and rates, before anything is allocated
-        finite = ch.t[np.isfinite(ch.t)]
-        problems = span_problems(float(finite[-1] - finite[0]), what=ch.label)
-        if problems:
-            raise InputError(f"{src}: {problems[0]}")
-    for ch in channels:
-        fast = ch.role in FAST_ROLES
-        need = limits.MIN_RATE_FAST if fast else limits.MIN_RATE_SLOW
-        if ch.f_s < need:
-            kind = "currents and rotor angles" if fast else "positions"
-            raise InputError(
-                f"{src}: {ch.label} is sampled at {ch.f_s:.4g} Hz; {kind} need at least {need:g} Hz"
-            )
-    for ch in channels:  # 2. plausibility
-        problems = value_problems(ch.role, ch.values, params, label=ch.label, row=ch.row)
-        if problems:
-            raise InputError(f"{src}: {problems[0]}")
+    _check_channels(channels, params, src)  # 1. span and rates, 2. plausibility
 
     breaks = {ch.role: clean_runs(ch) for ch in channels}  # 3. segments
     try:
         seg, candidates = common_segment(channels, breaks)
     except InputError as exc:
         raise InputError(f"{src}: {exc}") from None
-    runs = {ch.role: _run(ch, seg.runs[ch.role], seg.start, seg.end) for ch in channels}
-
-    angle_role = cmap.angle_role  # 4. angle ratio
-    angle_info: dict[str, Any] = {}
-    theta_e_run: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
-    if angle_role is not None:
-        t_ang, ang = runs[angle_role]
-        ang = np.unwrap(ang)
-        theta_e_run = (t_ang, ang * params.motor.p if angle_role == "theta_m" else ang)
-        ref_role = "theta_u" if "theta_u" in m else "theta_cmd"
-        t_ref, ref = runs[ref_role]
-        inside = (t_ref >= t_ang[0]) & (t_ref <= t_ang[-1])
-        problem, angle_info = angle_ratio(
-            angle_role, np.interp(t_ref[inside], t_ang, ang), ref_role, ref[inside], params
-        )
-        if problem:
-            raise InputError(f"{src}: {problem}")
+    runs = {ch.role: cut_run(ch, seg.runs[ch.role], seg.start, seg.end) for ch in channels}
+    theta_e_run, angle_info = _angle(m, runs, params)  # 4. angle ratio
 
     n = math.floor((seg.end - seg.start) * f_s + 1e-9) + 1  # 6. the model grid
     t_abs = seg.start + np.arange(n) / f_s
-    signals: dict[str, NDArray[np.float64]] = {}
-    resampling: dict[str, str] = {}
-
-    def to_grid(role: str, t_src: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
-        values, how = _to_grid(t_src, x, t_abs, f_s)
-        resampling[role] = how
-        return values
-
-    signals["theta_cmd"] = to_grid("theta_cmd", *runs["theta_cmd"])
-    alignment_report: dict[str, Any] = {}
-    if "i_q" in m:  # 5. i_q
-        signals["i_q"] = to_grid("i_q", *runs["i_q"])
-    if "theta_u" in m:
-        signals["theta_u"] = to_grid("theta_u", *runs["theta_u"])
-    else:
-        warnings.append(
-            "theta_u is not mapped: the trace has no measured position, so holds of the command where the "
-            "surface rests are told from the command alone"
-        )
-    if "i_a" in m and "i_q" in m:
-        warnings.append("the map gives i_q and the phase currents: i_q is used, the phases only stored")
-    if "i_a" in m:
-        t_cur, i_a = runs["i_a"]
-        i_b = _at(runs["i_b"], t_cur)
-        i_c = _at(runs["i_c"], t_cur) if "i_c" in m else None
-        if "i_q" not in m:
-            assert theta_e_run is not None  # the map requires an angle with the phase currents
-            offset = None if cmap.angle_offset_deg is None else math.radians(cmap.angle_offset_deg)
-            al = phases_to_iq(t_cur, i_a, i_b, i_c, np.interp(t_cur, *theta_e_run), params, offset=offset)
-            warnings += al.warnings
-            alignment_report = al.report
-            signals["i_q"] = to_grid("i_q", t_cur, al.i_q)
-            i_a, i_b, i_c = al.phases
-            flags += ["i_q_from_phases", "angle_offset_" + ("estimated" if offset is None else "given")]
-            flags += ["zero_sequence_removed"] if al.report.get("zero_sequence_removed") else []
-            flags += ["pi_added"] if al.report.get("pi_added") else []
-        if "i_c" not in m:
-            i_c = -i_a - i_b  # isolated neutral (DESIGN §3.4)
-            flags.append("i_c_reconstructed")
-        assert i_c is not None
-        for role, x in (("i_a", i_a), ("i_b", i_b), ("i_c", i_c)):
-            signals[role] = to_grid(role, t_cur, x)
-    if theta_e_run is not None:
-        theta0 = math.radians(alignment_report.get("offset_deg", cmap.angle_offset_deg or 0.0))
-        signals["theta_e"] = to_grid("theta_e", theta_e_run[0], theta_e_run[1] + theta0)
+    signals, resampling, alignment_report, flags = grid_signals(
+        m, runs, theta_e_run, params, t_abs, f_s, warnings
+    )
 
     t = t_abs - seg.start
     report = _report(m, params, f_s, seg, candidates, breaks, n, resampling, alignment_report, angle_info)
     cut = report["segments"]["dropped_s"] > 1.0 / f_s
     report["flags"] = flags + (["segment_cut"] if cut else [])
     if cut:
-        first, last = report["segments"]["record"]
-        used = report["segments"]["used"]
-        share = 100.0 * (used[1] - used[0]) / (last - first) if last > first else 100.0
-        late = used[0] - first > 1.0 / f_s
-        warnings.append(
-            f"gaps or NaN runs split the record: only {used[0]:g}..{used[1]:g} s ({share:.0f} % of it) is used"
-            + (
-                "; it starts inside the command, where the monitor starts from rest: the diagnosis is unreliable "
-                "unless the command was at rest there"
-                if late
-                else ""
-            )
-        )
+        warnings.append(_cut_warning(report["segments"], f_s))
     report["warnings"] = warnings
     metadata = {
         "model": "measured",
@@ -223,6 +131,64 @@ def to_reference(
     return Reference(trace, report)
 
 
+def _check_channels(channels: list[Channel], params: EmaParams, src: Any) -> None:
+    """Steps 1 and 2: each channel's span, rate and values; `InputError` naming the first problem."""
+    for ch in channels:  # 1. span and rates, before anything is allocated
+        finite = ch.t[np.isfinite(ch.t)]
+        problems = span_problems(float(finite[-1] - finite[0]), what=ch.label)
+        if problems:
+            raise InputError(f"{src}: {problems[0]}")
+    for ch in channels:
+        fast = ch.role in FAST_ROLES
+        need = limits.MIN_RATE_FAST if fast else limits.MIN_RATE_SLOW
+        if ch.f_s < need:
+            kind = "currents and rotor angles" if fast else "positions"
+            raise InputError(
+                f"{src}: {ch.label} is sampled at {ch.f_s:.4g} Hz; {kind} need at least {need:g} Hz"
+            )
+    for ch in channels:  # 2. plausibility
+        problems = value_problems(ch.role, ch.values, params, label=ch.label, row=ch.row)
+        if problems:
+            raise InputError(f"{src}: {problems[0]}")
+
+
+def _angle(m: Measurement, runs: dict[str, Run], params: EmaParams) -> tuple[Run | None, dict[str, Any]]:
+    """Step 4: the electrical angle's run (unwrapped; θ_m times p) and the angle-ratio check's
+    report, {} without a mapped angle; `InputError` when the ratio is not p·τ."""
+    angle_role = m.channel_map.angle_role
+    if angle_role is None:
+        return None, {}
+    t_ang, ang = runs[angle_role]
+    ang = np.unwrap(ang)
+    theta_e_run = (t_ang, ang * params.motor.p if angle_role == "theta_m" else ang)
+    ref_role = "theta_u" if "theta_u" in m else "theta_cmd"
+    t_ref, ref = runs[ref_role]
+    inside = (t_ref >= t_ang[0]) & (t_ref <= t_ang[-1])
+    problem, angle_info = angle_ratio(
+        angle_role, np.interp(t_ref[inside], t_ang, ang), ref_role, ref[inside], params
+    )
+    if problem:
+        raise InputError(f"{m.source}: {problem}")
+    return theta_e_run, angle_info
+
+
+def _cut_warning(segments: dict[str, Any], f_s: float) -> str:
+    """The warning for a record that gaps or NaN runs split (`segments` of the report)."""
+    first, last = segments["record"]
+    used = segments["used"]
+    share = 100.0 * (used[1] - used[0]) / (last - first) if last > first else 100.0
+    late = used[0] - first > 1.0 / f_s
+    return (
+        f"gaps or NaN runs split the record: only {used[0]:g}..{used[1]:g} s ({share:.0f} % of it) is used"
+        + (
+            "; it starts inside the command, where the monitor starts from rest: the diagnosis is unreliable "
+            "unless the command was at rest there"
+            if late
+            else ""
+        )
+    )
+
+
 def write_reference(reference: Reference, path: str | os.PathLike[str]) -> Path:
     """Write the reference's trace with `emaphm.io.write_trace` (atomic; HDF5 or CSV + JSON).
 
@@ -232,50 +198,6 @@ def write_reference(reference: Reference, path: str | os.PathLike[str]) -> Path:
     from ..io import write_trace
 
     return write_trace(reference.trace, path)
-
-
-def _run(
-    ch: Channel, run: tuple[int, int], start: float, end: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The samples of `ch`'s clean run that lie within the segment ± `_MARGIN`."""
-    a, b = run
-    t = ch.t[a : b + 1]
-    lo = max(int(np.searchsorted(t, start - _MARGIN, side="right")) - 1, 0)
-    hi = min(int(np.searchsorted(t, end + _MARGIN, side="left")) + 1, len(t))
-    return t[lo:hi], ch.values[a : b + 1][lo:hi]
-
-
-def _at(run: tuple[NDArray[np.float64], NDArray[np.float64]], t: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Another current on the grid t: as is when it shares the grid, else interpolated."""
-    t_src, x = run
-    if len(t_src) == len(t) and np.array_equal(t_src, t):
-        return x
-    return np.interp(t, t_src, x)
-
-
-def _to_grid(
-    t_src: NDArray[np.float64], x: NDArray[np.float64], t_grid: NDArray[np.float64], f_s: float
-) -> tuple[NDArray[np.float64], str]:
-    """`signals.resample`, after regularising a jittered fast source; and what was done."""
-    steps = np.diff(t_src)
-    step = float(np.median(steps))
-    f_src = 1.0 / step
-    how = ""
-    if f_src > ANTI_ALIAS_ABOVE * f_s and np.max(np.abs(steps - step)) > _UNIFORM * step:
-        t_reg = t_src[0] + np.arange(math.ceil((t_src[-1] - t_src[0]) / step) + 1) * step
-        x = np.interp(t_reg, t_src, x)
-        t_src = t_reg
-        how = f"jittered: interpolated to a uniform {f_src:.6g} Hz grid, then "
-    if f_src > ANTI_ALIAS_ABOVE * f_s:
-        how += (
-            f"low-passed at {ANTI_ALIAS_FRACTION * f_s:g} Hz on its {f_src:.6g} Hz grid, then interpolated "
-            f"to {f_s:g} Hz"
-        )
-    elif f_src < f_s / ANTI_ALIAS_ABOVE:
-        how += f"interpolated linearly from {f_src:.6g} Hz to {f_s:g} Hz"
-    else:
-        how += f"interpolated at the same rate ({f_src:.6g} Hz)"
-    return resample(t_src, x, t_grid, f_s), how
 
 
 def _report(

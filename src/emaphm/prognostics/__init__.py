@@ -4,9 +4,11 @@
   variance (MATLAB-like ``update`` / ``restart`` / ``predict_rul``), and `RulEstimate`;
 - `rul`: `rul_report`, the RUL of each tracked fault and of the first failure of an actuator of a
   campaign store (`emaphm.campaign`), with the failure thresholds and their status;
+- `requirements`: `Requirement`, `parse_requirement`: the limits the actuator must meet (tracking
+  error, current demand, free play);
 - `thresholds`: `derive_thresholds`, the failure threshold of each fault from the HF twin and
-  requirements (`Requirement`, `parse_requirement`: tracking error, current demand, free play),
-  and `thresholds_toml`, the ``[thresholds]`` table of the actuator file;
+  the requirements, found by `threshold_search` (a grid, then bisection); `threshold_table`:
+  `thresholds_toml`, the ``[thresholds]`` table of the actuator file;
 - `progpy_model` (the optional ``progpy`` extra; imported only when asked for): the fault-growth
   laws as a ProgPy ``PrognosticsModel`` (`FaultGrowth`), tracked by ProgPy's UKF with each
   identification's own variance (``emaphm rul --estimator ukf``), ProgPy's MonteCarlo predictor
@@ -19,8 +21,11 @@ lines; docs/prognostics.md the guide.
 
 from __future__ import annotations
 
-from .rul import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds, rul_report
-from .thresholds import REQUIREMENT_KINDS, Requirement, derive_thresholds, parse_requirement, thresholds_toml
+from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds
+from .requirements import REQUIREMENT_KINDS, Requirement, parse_requirement
+from .rul import rul_report
+from .threshold_table import thresholds_toml
+from .thresholds import derive_thresholds
 from .trend import LAWS, DegradationTrend, RulEstimate
 
 __all__ = [

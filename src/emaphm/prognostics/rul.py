@@ -9,8 +9,8 @@ threshold gives the RUL in flights, per fault and for the first failure.
 
 Failure thresholds, as distances from healthy in fault units: given (``--threshold``, or the
 ``[thresholds]`` table of the actuator file), or the placeholders of `PLACEHOLDER_THRESHOLDS`
-(next-features §B.3), which every output marks ``"placeholder": true``: a placeholder is not an
-airworthiness limit.
+(`emaphm.failure`, next-features §B.3), which every output marks ``"placeholder": true``: a
+placeholder is not an airworthiness limit.
 """
 
 from __future__ import annotations
@@ -24,58 +24,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds  # re-exported
 from .trend import DegradationTrend, RulEstimate
 
-__all__ = ["ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "rul_report"]
+__all__ = ["ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "parse_thresholds", "rul_report"]
 
-# tracked faults: name -> (column, law, healthy value); k7 (a direction) is not a damage
-FAULTS: dict[str, tuple[str, str, float]] = {
-    "friction": ("k1", "linear", 0.0),
-    "backlash": ("k2", "linear", 0.0),
-    "short_a": ("k3", "exponential", 0.0),
-    "short_b": ("k4", "exponential", 0.0),
-    "short_c": ("k5", "exponential", 0.0),
-    "eccentricity": ("k6", "linear", 0.0),
-    "kp_drift": ("k8", "linear", 0.5),
-}
-# distances from healthy at which each fault fails, when none is given (next-features §B.3):
-# friction and backlash are actuator- and airframe-specific, shorts self-accelerate past a fifth
-# of a winding, eccentricity well before a rub, gain drift past its stability margin
-PLACEHOLDER_THRESHOLDS: dict[str, float] = {
-    "friction": 0.5, "backlash": 0.25, "short_a": 0.2, "short_b": 0.2, "short_c": 0.2,
-    "eccentricity": 0.3, "kp_drift": 0.3,
-}  # fmt: skip
 SAMPLES = 4000
 _NO_RUL = {"rul_median": None, "rul_p05": None, "rul_p95": None}
 ESTIMATORS = ("trend", "ukf")
-
-
-def parse_thresholds(
-    items: list[str] | dict[str, Any] | None, where: str = "--threshold"
-) -> dict[str, float]:
-    """{"friction": 0.45, ...} from ``["friction=0.45", ...]`` or a dict; `InputError` naming a bad one."""
-    if not items:
-        return {}
-    pairs = items.items() if isinstance(items, dict) else (_split(s, where) for s in items)
-    out = {}
-    for name, value in pairs:
-        if name not in FAULTS:
-            raise InputError(f"{where}: unknown fault {name!r}; choose from {', '.join(FAULTS)}")
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise InputError(f"{where}: {name} = {value!r} is not a number") from None
-        if not (math.isfinite(v) and 0 < v <= 1):
-            raise InputError(f"{where}: {name} = {v!r} must be a distance from healthy in (0, 1]")
-        out[name] = v
-    return out
-
-
-def _split(item: str, where: str) -> tuple[str, str]:
-    if "=" not in item:
-        raise InputError(f"{where}: {item!r} must be FAULT=VALUE, e.g. friction=0.45")
-    name, value = item.split("=", 1)
-    return name.strip(), value.strip()
 
 
 def history(
@@ -182,10 +138,42 @@ def rul_report(
         if not rows:
             raise InputError(f"actuator {actuator!r} has no flight at or before {at_flight}")
     t_now = float(at_flight if at_flight is not None else rows[-1]["flight"])
-    given = dict(thresholds or {})
-    faults: dict[str, Any] = {}
+    faults, tracked = _tracked(rows, dict(thresholds or {}))
     trends: dict[str, Any] = {}
     estimates: dict[str, RulEstimate] = {}
+    # the faults' trends drawn together: estimates of one identification are correlated (its
+    # corr), and so are the trends fitted to them; this matters for the first failure
+    drawn = list(tracked)
+    rho = _correlations(rows, drawn) if drawn else np.eye(0)
+    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
+    for i, name in enumerate(drawn):
+        trend, threshold, entry = tracked[name]
+        assert normals is not None
+        if estimator == "ukf":
+            model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
+            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
+            trends[name] = progpy_model.UkfTrend(trend, ukf)
+        else:
+            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
+            trends[name] = trend
+        estimates[name] = est
+        faults[name] = {**entry, "status": "tracked", **est.to_json(),
+                        "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
+    faults = {name: faults[name] for name in FAULTS}  # in the order of FAULTS
+    first = _first_failure(estimates, drawn, rho, faults, t_now, inspection_interval)
+    return {
+        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
+        "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
+        "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
+    }  # fmt: skip
+
+
+def _tracked(
+    rows: list[dict[str, Any]], given: dict[str, float]
+) -> tuple[dict[str, Any], dict[str, tuple[DegradationTrend, float, dict[str, Any]]]]:
+    """Each fault's entry of the report when it cannot be tracked (not detected, or too few
+    measurements), and the trend, threshold and entry of each one that can."""
+    faults: dict[str, Any] = {}
     tracked: dict[str, tuple[DegradationTrend, float, dict[str, Any]]] = {}
     for name, (_, law, healthy) in FAULTS.items():
         threshold = given.get(name, PLACEHOLDER_THRESHOLDS[name])
@@ -206,25 +194,19 @@ def rul_report(
             faults[name] = {**entry, "status": "too few measurements", **_NO_RUL}
             continue
         tracked[name] = (trend, threshold, entry)
-    # the faults' trends drawn together: estimates of one identification are correlated (its
-    # corr), and so are the trends fitted to them; this matters for the first failure
-    drawn = list(tracked)
-    rho = _correlations(rows, drawn) if drawn else np.eye(0)
-    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
-    for i, name in enumerate(drawn):
-        trend, threshold, entry = tracked[name]
-        assert normals is not None
-        if estimator == "ukf":
-            model, ukf = progpy_model.track(name, entry["law"], threshold, trend.t, trend.k, trend.sd)
-            est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
-            trends[name] = progpy_model.UkfTrend(trend, ukf)
-        else:
-            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
-            trends[name] = trend
-        estimates[name] = est
-        faults[name] = {**entry, "status": "tracked", **est.to_json(),
-                        "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
-    faults = {name: faults[name] for name in FAULTS}  # in the order of FAULTS
+    return faults, tracked
+
+
+def _first_failure(
+    estimates: dict[str, RulEstimate],
+    drawn: list[str],
+    rho: NDArray[np.float64],
+    faults: dict[str, Any],
+    t_now: float,
+    inspection_interval: float,
+) -> dict[str, Any]:
+    """The RUL of the first failure (the earliest crossing of each joint draw), added to
+    `estimates` as "first failure"."""
     first: dict[str, Any] = {"status": "no fault tracked"}
     if estimates:
         stacked = np.vstack([e.samples for e in estimates.values()])
@@ -240,8 +222,4 @@ def rul_report(
             "placeholder_thresholds": sorted(n for n in estimates if faults[n]["placeholder"]),
         }  # fmt: skip
         estimates["first failure"] = est
-    return {
-        "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
-        "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
-        "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
-    }  # fmt: skip
+    return first
