@@ -11,7 +11,8 @@ from emaphm.identification.api import identify
 from emaphm.identification.detection import detect
 from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.metrics import absolute_errors, percent_error
-from emaphm.identification.optimizers import OPTIMIZERS, Stagnation, run_optimizer
+from emaphm.identification.optimizers import OPTIMIZERS, Stagnation
+from emaphm.identification.search import run_optimizer
 
 # Budgets. The global search only has to land in the right basin; the CMA-ES polish does the
 # converging. TINY checks plumbing and determinism, not convergence.

@@ -16,9 +16,9 @@ from emaphm.identification.optimizers import (
     OptimizerRun,
     Stagnation,
     minimize_batch,
-    run_optimizer,
 )
 from emaphm.identification.polish import least_squares_polish, polish
+from emaphm.identification.search import run_optimizer
 
 CENTRE = np.array([0.2, 0.7, 0.4, 0.1, 0.9, 0.5, 0.3, 0.6])
 BUDGET = {"pop_size": 20, "generations": 50}

@@ -1,4 +1,4 @@
-"""The grey wolf optimiser (GWO, Mirjalili et al. 2014), vectorised and seeded (`optimizers.run_optimizer`)."""
+"""The grey wolf optimiser (GWO, Mirjalili et al. 2014), vectorised and seeded (`search.run_optimizer`)."""
 
 from __future__ import annotations
 

@@ -24,8 +24,11 @@ switching last stage, measured and not built").
 
 Each iteration costs one switching evaluation (one twin run per step, side by side on threads)
 and one least-squares polish of the monitor; `limits.SWITCHING_ITERATIONS` of them, after one at the
-search's estimate. The final estimate is the iterate the switching model fits best (eq. 3), the
-search's estimate among them: where that one fits best, it stands (`SwitchingStage.taken`).
+search's estimate. The final estimate is the iterate with the lowest sum of the switching model's
+eq. 3 and the corrected monitor's under the last correction d̄ (the switching model's alone
+carries the chaotic stick–slip realisation of its runs; review L3), the search's estimate among
+them: where that one wins, it stands (`SwitchingStage.taken`). The iterations stop early when a
+run diverges or the polish leaves the point where it was; the record says why.
 """
 
 from __future__ import annotations
@@ -68,7 +71,7 @@ def switching_steps(params: EmaParams) -> tuple[float, ...]:
     """The switching model's integration steps [s] for an actuator: `limits.SWITCHING_STEP_FACTORS`
     times its own step dt, each rounded to the nearest whole fraction 1/(n·f_s) of its sample
     period (`EmaParams` needs a whole number of steps per sample): 2, 2.5 and 1.25 µs at the
-    paper's 1 µs and 10 kHz; 2.016, 2.5 and 1.25 µs at 8 kHz."""
+    paper's 1 µs and 10 kHz; 1.98, 2.5 and 1.25 µs at 8 kHz."""
     period = 1.0 / params.controller.f_s
     steps = []
     for factor in limits.SWITCHING_STEP_FACTORS:
@@ -127,7 +130,9 @@ class SwitchingStage:
     estimate (unfiltered); fitness, fit_nrmse : its eq. 3 and NRMSE over the compared samples;
     start_fitness : the switching model's eq. 3 at the search's estimate; iterate : the iterate
     taken (0: the search's estimate, and objective the monitor's own); evaluations : the monitor's
-    in the least-squares polishes; history : the switching model's eq. 3 at each iterate.
+    in the least-squares polishes and the choice; history : the switching model's eq. 3 at each
+    iterate; smooth : the corrected monitor's eq. 3 under the last correction there (the iterate
+    taken has the lowest sum of the two); stopped : why the iterations ended; points : the iterates.
     """
 
     x: NDArray[np.float64]
@@ -139,6 +144,9 @@ class SwitchingStage:
     iterate: int
     evaluations: int
     history: list[float]
+    smooth: list[float]
+    stopped: str
+    points: list[NDArray[np.float64]]
 
     @property
     def taken(self) -> bool:
@@ -151,13 +159,17 @@ class SwitchingStage:
             "steps_s": [float(s) for s in steps],
             "iterations": len(self.history) - 1,
             "taken": self.taken,
-            # the iterate taken: the one the switching model fits best (0: the search's estimate)
+            # the iterate taken: the lowest sum of the switching model's eq. 3 and the corrected
+            # monitor's (0: the search's estimate); why the iterations ended
             "iterate": self.iterate,
+            "stopped": self.stopped,
             "start_fitness": _rounded(self.start_fitness),
             "fitness": _rounded(self.fitness),
             "fit_nrmse": _rounded(self.fit_nrmse),
             # the switching model's eq. 3 at the search's estimate and after each iteration
             "history": [_rounded(f) for f in self.history],
+            # the corrected monitor's eq. 3 under the last correction at each iterate
+            "smooth_history": [_rounded(f) for f in self.smooth],
             "monitor_evaluations": self.evaluations,
         }
 
@@ -181,16 +193,13 @@ def space_mapping(
     `objective` is eq. 3 against the measurement; `residuals_of(fitness)` gives eq. 3's residual
     vectors for rows of the box under another `Fitness` (`Context.residuals`);
     `monitor_current(k)` and `switching_current(k)` the two models' unfiltered currents for one
-    fault vector k; `to_faults` maps rows of the box to fault rows (`search_to_faults`).
-    A switching run that diverges ends the iterations; the best iterate so far is taken. A
-    switching run at x0 that diverges raises `SimulationError`.
+    fault vector k; `to_faults` maps rows of the box to fault rows (`search_to_faults`). The
+    iterations stop early when a run diverges or the polish does not move the point (the record
+    says which). A switching run at x0 that diverges raises `SimulationError`.
     """
     iterations = limits.SWITCHING_ITERATIONS if iterations is None else iterations
     if iterations < 1:
         raise InputError(f"the switching stage needs at least one iteration, got {iterations}")
-    keep = objective.weights > 0
-    x = np.array(x0, dtype=np.float64, copy=True)
-    evaluations = 0
 
     def switching_fit(x: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
         current = switching_current(to_faults(x[None, :])[0])
@@ -198,30 +207,53 @@ def space_mapping(
             raise SimulationError("the switching model diverged")
         return current, float(objective(current))
 
+    x = np.array(x0, dtype=np.float64, copy=True)
     current, f = switching_fit(x)
     # each iterate: its point, the switching model's current and eq. 3 there, the corrected eq. 3
     iterates = [(x, current, f, objective)]
-    d_mean = np.zeros_like(objective.reference.reference)
-    try:
-        for j in range(iterations):
+    d_mean, evaluations, stopped = np.zeros_like(objective.reference.reference), 0, "all iterations run"
+    for j in range(iterations):
+        try:
             d = objective.reference.filtered(current - monitor_current(to_faults(x[None, :])[0]))
-            d_mean = d_mean + (d - d_mean) / (j + 1)
-            corrected = objective.shifted(d_mean)
-            residuals = residuals_of(corrected)
-            r0 = residuals(x[None, :])[0]
-            run = least_squares_polish(residuals, OptimizerRun(x, float(r0 @ r0), 1, []))
-            evaluations += run.evaluations
-            x = np.array(run.x, dtype=np.float64)
+        except SimulationError:
+            stopped = f"the monitor diverged at iterate {j}"
+            break
+        d_mean = d_mean + (d - d_mean) / (j + 1)
+        corrected = objective.shifted(d_mean)
+        residuals = residuals_of(corrected)
+        r0 = residuals(x[None, :])[0]
+        run = least_squares_polish(residuals, OptimizerRun(x, float(r0 @ r0), 1, []))
+        evaluations += run.evaluations
+        if np.array_equal(run.x, x):
+            stopped = f"the polish did not move the estimate at iterate {j + 1}"
+            break
+        x = np.array(run.x, dtype=np.float64)
+        try:
             current, f = switching_fit(x)
-            iterates.append((x, current, f, corrected))
-    except SimulationError:  # a diverged run: the iterates so far stand
-        pass
+        except SimulationError:
+            stopped = f"the switching model diverged at iterate {j + 1}"
+            break
+        iterates.append((x, current, f, corrected))
+    smooth = _smooth_fitness(residuals_of(objective.shifted(d_mean)), [it[0] for it in iterates])
+    evaluations += len(iterates)
     history = [it[2] for it in iterates]
-    best = int(np.argmin(history))
+    best = int(np.argmin(np.asarray(history) + smooth))
     x, current, fitness, corrected = iterates[best]
-    fitted = objective.reference.filtered(current)
-    fit_nrmse = float(nrmse(objective.reference.reference[keep], fitted[keep]))
-    return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history)
+    keep = objective.weights > 0
+    fit_nrmse = float(nrmse(objective.reference.reference[keep], objective.reference.filtered(current)[keep]))
+    return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history,
+                          [float(v) for v in smooth], stopped, [it[0] for it in iterates])  # fmt: skip
+
+
+def _smooth_fitness(
+    residuals: Callable[[NDArray[np.float64]], NDArray[np.float64]], points: list[Any]
+) -> NDArray[np.float64]:
+    """The corrected monitor's eq. 3 under the last correction d̄ at each iterate (inf where its
+    run diverges): smooth in the faults, where the switching model's eq. 3 carries the chaotic
+    stick-slip realisation of its runs (review L3); the choice among iterates adds the two."""
+    R = residuals(np.array(points))
+    f = np.sum(R * R, axis=1)
+    return np.where(np.isfinite(f), f, np.inf)  # type: ignore[no-any-return]
 
 
 def last_stage(state: State | None, context: Context) -> tuple[State, Record]:

@@ -37,7 +37,6 @@ from pymoo.termination.robust import RobustTermination
 
 from ..choices import OPTIMIZERS
 from ..errors import InputError
-from . import limits
 
 __all__ = [
     "OPTIMIZERS",
@@ -48,7 +47,7 @@ __all__ = [
     "Stagnation",
     "check_optimizer",
     "minimize_batch",
-    "run_optimizer",
+    "run_pymoo",
 ]
 
 Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
@@ -192,11 +191,11 @@ def minimize_batch(
         if stagnation is None
         else stagnation.termination(generations)
     )
-    x, f, history, _ = _minimize(problem, algorithm, termination, generations, seed, on_generation)
+    x, f, history, _ = run_pymoo(problem, algorithm, termination, generations, seed, on_generation)
     return x, f, history
 
 
-def _minimize(
+def run_pymoo(
     problem: BatchProblem,
     algorithm: Any,
     termination: Termination,
@@ -216,63 +215,3 @@ def check_optimizer(name: str) -> str:
     if name not in OPTIMIZERS:
         raise InputError(f"unknown optimizer {name!r}; choose one of {', '.join(OPTIMIZERS)}")
     return name
-
-
-def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator) -> Any:
-    if name == "ga":
-        from pymoo.algorithms.soo.nonconvex.ga import GA
-        from pymoo.operators.crossover.pcx import PCX
-
-        return GA(pop_size=pop_size, crossover=PCX(eta=0.5, zeta=0.5))
-    if name == "de":
-        from pymoo.algorithms.soo.nonconvex.de import DE
-
-        return DE(pop_size=pop_size, variant="DE/rand/1/bin", CR=0.7, F=0.6)
-    if name == "pso":
-        from pymoo.algorithms.soo.nonconvex.pso import PSO
-
-        return PSO(pop_size=pop_size)
-    if name == "cmaes":
-        from .cmaes import cmaes
-
-        return cmaes(rng.uniform(0.2, 0.8, n_var), 0.3, pop_size, generations)
-    raise AssertionError(f"no pymoo algorithm for {name!r}")  # names are checked before
-
-
-def run_optimizer(
-    name: str,
-    evaluate: Objective,
-    *,
-    n_var: int = 8,
-    pop_size: int | None = None,
-    generations: int | None = None,
-    seed: int = 0,
-    stagnation: Stagnation | None = None,
-    on_generation: OnGeneration | None = None,
-) -> OptimizerRun:
-    """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`).
-
-    Stops at `generations` or when `stagnation` (default `Stagnation()`) says so.
-    """
-    check_optimizer(name)
-    default_pop, default_gen = limits.DEFAULT_BUDGETS[name]
-    pop_size = default_pop if pop_size is None else pop_size
-    generations = default_gen if generations is None else generations
-    if pop_size < 4 or generations < 1:
-        raise InputError(
-            f"need a population of at least 4 and 1 generation, got {pop_size} and {generations}"
-        )
-    stop = stagnation if stagnation is not None else Stagnation()
-    rng = np.random.default_rng(seed)
-    problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
-    if name == "gwo":
-        from .gwo import grey_wolf
-
-        return grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
-    x, f, history, res = _minimize(
-        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng), stop.termination(generations),
-        generations, seed, on_generation,
-    )  # fmt: skip
-    pop = res.pop
-    return OptimizerRun(x, f, problem.evaluations, history, np.clip(pop.get("X"), problem.xl, problem.xu),
-                        np.asarray(pop.get("F"), dtype=np.float64).reshape(-1))  # fmt: skip
