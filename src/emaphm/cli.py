@@ -364,7 +364,7 @@ def calibrate(
     """Re-run the LF calibration against the HF twin (of the actuator file) and write the calibration file."""
     from .actuator import resolve_params
     from .calibration import load_calibration
-    from .identification.calibrate import calibrate as run_calibration
+    from .calibration.fit_monitor import calibrate as run_calibration
     from .io import check_output_path
     from .models import check_seed
 

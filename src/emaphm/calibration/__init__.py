@@ -5,9 +5,18 @@ the files that identification reads.
 
 - `coefficients`: `Coefficients`, the monitor's calibrated constants, and their search box;
 - `files`: `Calibration`, the versioned calibration file, its loaders and `params_hash`;
+- `scenarios`: the commands and the fitting and check scenarios (`CALIBRATION_COMMANDS`,
+  `FIT_SCENARIOS`, `CHECK_SCENARIOS`, ...), the HF references and the LF NRMSE of each;
+- `fit_monitor`: `calibrate`, the GA fit of the coefficients (``emaphm calibrate``);
+
+The fits load on first use (PEP 562): reading a calibration file needs neither pymoo nor the
+twin, and the monitor model (`emaphm.models`) imports this package.
 """
 
 from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 from .coefficients import (
     ACTUATOR_SCALED,
@@ -28,19 +37,65 @@ from .files import (
     params_hash,
 )
 
+# public name -> the submodule that defines it, imported on first use
+_LAZY = {
+    **dict.fromkeys(
+        ("CALIBRATION_COMMANDS", "CHECK_SCENARIOS", "FIT_SCENARIOS", "PAPER_CHECK_SCENARIOS",
+         "PAPER_FIT_SCENARIOS", "Scenario", "hf_references", "scenario_nrmse"),
+        "scenarios",
+    ),
+    "calibrate": "fit_monitor",
+}  # fmt: skip
+
 __all__ = [
     "ACTUATOR_SCALED",
     "BAND_SCALED",
+    "CALIBRATION_COMMANDS",
+    "CHECK_SCENARIOS",
     "COEFFICIENT_BOUNDS",
+    "FIT_SCENARIOS",
     "MONITOR_FILES",
     "NAMEPLATE_SCALED",
+    "PAPER_CHECK_SCENARIOS",
+    "PAPER_FIT_SCENARIOS",
     "SURROGATE",
     "Calibration",
     "Coefficients",
+    "Scenario",
     "actuator_params",
+    "calibrate",
     "check_monitor",
     "coefficient_bounds",
     "default_calibration",
+    "hf_references",
     "load_calibration",
     "params_hash",
+    "scenario_nrmse",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'emaphm.calibration' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # later lookups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
+
+if TYPE_CHECKING:  # what type checkers and IDEs see
+    from .fit_monitor import calibrate
+    from .scenarios import (
+        CALIBRATION_COMMANDS,
+        CHECK_SCENARIOS,
+        FIT_SCENARIOS,
+        PAPER_CHECK_SCENARIOS,
+        PAPER_FIT_SCENARIOS,
+        Scenario,
+        hf_references,
+        scenario_nrmse,
+    )
