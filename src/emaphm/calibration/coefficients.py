@@ -11,6 +11,7 @@ within `coefficient_bounds(params)`; `emaphm.calibration.files` stores them.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +25,7 @@ __all__ = [
     "NAMEPLATE_SCALED",
     "SURROGATE",
     "Coefficients",
+    "checked_free",
     "coefficient_bounds",
 ]
 
@@ -181,3 +183,18 @@ def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
 # the loop-error surrogate's coefficients, the loop's breakaway ripple and its dead zone, which
 # the paper's monitor holds at zero (V_H, a scale, has no effect then)
 SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "i_R", "i_D")
+
+
+def checked_free(free: Sequence[str] | None, allowed: Sequence[str], monitor: str) -> list[str]:
+    """The coefficients a calibration fits: `free` checked against the monitor's (all when None)."""
+    if free is None:
+        return list(allowed)
+    names = list(dict.fromkeys(free))
+    if not names:
+        raise InputError("free must name at least one coefficient to fit")
+    for n in names:
+        if n not in allowed:
+            raise InputError(
+                f"cannot fit {n!r} for the {monitor!r} monitor; choose from {', '.join(allowed)}"
+            )
+    return [n for n in allowed if n in names]  # in the box's order

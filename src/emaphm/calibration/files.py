@@ -20,6 +20,7 @@ import functools
 import hashlib
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,6 +36,7 @@ __all__ = [
     "actuator_params",
     "check_monitor",
     "default_calibration",
+    "held_coefficients",
     "load_calibration",
     "params_hash",
 ]
@@ -245,3 +247,39 @@ def default_calibration(monitor: str = "default") -> Calibration:
     if cal.monitor != monitor:
         raise InputError(f"emaphm/data/{name} holds the {cal.monitor!r} monitor, not {monitor!r}")
     return cal
+
+
+def held_coefficients(
+    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams, n_lf: int = 1
+) -> tuple[Coefficients, str]:
+    """The coefficients a calibration starts from and holds where it does not fit, and what they are.
+
+    The first guess without `free`; with it, `start` or the packaged calibration (of the nominal
+    actuator only: another actuator's must be given). `start` must be of the same monitor,
+    actuator and LF step (`n_lf`), and comes only with `free`.
+    """
+    if start is not None and free is None:
+        raise InputError("a calibration to start from needs the coefficients to fit (free=, --free)")
+    if start is None and free is None:
+        return Coefficients.first_guess(params), "first guess"
+    if start is None:
+        if params_hash(params) != params_hash(EmaParams()):
+            raise InputError(
+                "fitting some coefficients of another actuator needs its own calibration to start "
+                "from (start=, --start)"
+            )
+        start = default_calibration(monitor)
+        label = "packaged"
+    else:
+        label = "given"
+    if start.monitor != monitor:
+        raise InputError(
+            f"the calibration to start from is for the {start.monitor!r} monitor, not {monitor!r}"
+        )
+    start.check_params(params, where="the calibration to start from")
+    if start.n_lf != n_lf:
+        raise InputError(
+            f"the calibration to start from was made with n_lf = {start.n_lf}, this one uses {n_lf}"
+        )
+    made = start.record.get("created", "unknown date")
+    return start.coefficients, f"{label} calibration made {made} ({start.params_hash or 'unbound'})"

@@ -33,8 +33,8 @@ from ..identification.optimizers import BatchProblem, minimize_batch
 from ..identification.signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 from ..models import check_seed
 from ..params import EmaParams
-from .coefficients import SURROGATE, Coefficients, coefficient_bounds
-from .files import Calibration, check_monitor, default_calibration, params_hash
+from .coefficients import SURROGATE, Coefficients, checked_free, coefficient_bounds
+from .files import Calibration, check_monitor, held_coefficients
 from .scenarios import (
     CALIBRATION_COMMANDS,
     CHECK_SCENARIOS,
@@ -47,58 +47,7 @@ from .scenarios import (
     scenario_nrmse,
 )
 
-__all__ = ["calibrate", "checked_free", "held_coefficients"]
-
-
-def checked_free(free: Sequence[str] | None, allowed: Sequence[str], monitor: str) -> list[str]:
-    """The coefficients a calibration fits: `free` checked against the monitor's (all when None)."""
-    if free is None:
-        return list(allowed)
-    names = list(dict.fromkeys(free))
-    if not names:
-        raise InputError("free must name at least one coefficient to fit")
-    for n in names:
-        if n not in allowed:
-            raise InputError(
-                f"cannot fit {n!r} for the {monitor!r} monitor; choose from {', '.join(allowed)}"
-            )
-    return [n for n in allowed if n in names]  # in the box's order
-
-
-def held_coefficients(
-    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams, n_lf: int = 1
-) -> tuple[Coefficients, str]:
-    """The coefficients a calibration starts from and holds where it does not fit, and what they are.
-
-    The first guess without `free`; with it, `start` or the packaged calibration (of the nominal
-    actuator only: another actuator's must be given). `start` must be of the same monitor,
-    actuator and LF step (`n_lf`), and comes only with `free`.
-    """
-    if start is not None and free is None:
-        raise InputError("a calibration to start from needs the coefficients to fit (free=, --free)")
-    if start is None and free is None:
-        return Coefficients.first_guess(params), "first guess"
-    if start is None:
-        if params_hash(params) != params_hash(EmaParams()):
-            raise InputError(
-                "fitting some coefficients of another actuator needs its own calibration to start "
-                "from (start=, --start)"
-            )
-        start = default_calibration(monitor)
-        label = "packaged"
-    else:
-        label = "given"
-    if start.monitor != monitor:
-        raise InputError(
-            f"the calibration to start from is for the {start.monitor!r} monitor, not {monitor!r}"
-        )
-    start.check_params(params, where="the calibration to start from")
-    if start.n_lf != n_lf:
-        raise InputError(
-            f"the calibration to start from was made with n_lf = {start.n_lf}, this one uses {n_lf}"
-        )
-    made = start.record.get("created", "unknown date")
-    return start.coefficients, f"{label} calibration made {made} ({start.params_hash or 'unbound'})"
+__all__ = ["calibrate"]
 
 
 def calibrate(
