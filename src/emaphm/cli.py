@@ -407,7 +407,7 @@ def calibrate_uq(
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from .actuator import resolve_params
-    from .identification.calibrate_uq import calibrate_uq as run_calibrate_uq
+    from .calibration.fit_intervals import calibrate_uq as run_calibrate_uq
     from .io import check_output_path
     from .models import MonitorEma, check_seed
 

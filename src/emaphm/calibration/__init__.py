@@ -8,6 +8,7 @@ the files that identification reads.
 - `scenarios`: the commands and the fitting and check scenarios (`CALIBRATION_COMMANDS`,
   `FIT_SCENARIOS`, `CHECK_SCENARIOS`, ...), the HF references and the LF NRMSE of each;
 - `fit_monitor`: `calibrate`, the GA fit of the coefficients (``emaphm calibrate``);
+- `fit_intervals`: `calibrate_uq`, the 90 % intervals' scale and floor (``emaphm calibrate-uq``);
 
 The fits load on first use (PEP 562): reading a calibration file needs neither pymoo nor the
 twin, and the monitor model (`emaphm.models`) imports this package.
@@ -45,6 +46,7 @@ _LAZY = {
         "scenarios",
     ),
     "calibrate": "fit_monitor",
+    **dict.fromkeys(("UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"), "fit_intervals"),
 }  # fmt: skip
 
 __all__ = [
@@ -59,13 +61,18 @@ __all__ = [
     "PAPER_CHECK_SCENARIOS",
     "PAPER_FIT_SCENARIOS",
     "SURROGATE",
+    "UQ_ABSENT",
+    "UQ_CASES",
+    "UQ_CASE_SEED",
     "Calibration",
     "Coefficients",
     "Scenario",
     "actuator_params",
     "calibrate",
+    "calibrate_uq",
     "check_monitor",
     "coefficient_bounds",
+    "collect_cases",
     "default_calibration",
     "hf_references",
     "load_calibration",
@@ -88,6 +95,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
+    from .fit_intervals import UQ_ABSENT, UQ_CASE_SEED, UQ_CASES, calibrate_uq, collect_cases
     from .fit_monitor import calibrate
     from .scenarios import (
         CALIBRATION_COMMANDS,
