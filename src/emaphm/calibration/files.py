@@ -15,6 +15,7 @@ out of the comparison and of the digest.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
 import hashlib
@@ -239,10 +240,19 @@ def check_monitor(monitor: Any) -> str:
     return monitor
 
 
-@functools.lru_cache(maxsize=len(MONITOR_FILES))
 def default_calibration(monitor: str = "default") -> Calibration:
-    """The calibration shipped with the package for `monitor` (``emaphm/data/calibration*.json``), read once."""
-    name = MONITOR_FILES[check_monitor(monitor)]
+    """The calibration shipped with the package for `monitor` (``emaphm/data/calibration*.json``).
+
+    The file is read once; each call returns its own copy of the record, so that a caller that
+    changes it cannot change what the next one gets (the coefficients are frozen).
+    """
+    cal = _packaged(check_monitor(monitor))
+    return dataclasses.replace(cal, record=copy.deepcopy(cal.record))
+
+
+@functools.lru_cache(maxsize=len(MONITOR_FILES))
+def _packaged(monitor: str) -> Calibration:
+    name = MONITOR_FILES[monitor]
     cal = _parse(read_package_json(name), f"emaphm/data/{name}")
     if cal.monitor != monitor:
         raise InputError(f"emaphm/data/{name} holds the {cal.monitor!r} monitor, not {monitor!r}")
