@@ -9,6 +9,7 @@ the files that identification reads.
   `FIT_SCENARIOS`, `CHECK_SCENARIOS`, ...), the HF references and the LF NRMSE of each;
 - `fit_monitor`: `calibrate`, the GA fit of the coefficients (``emaphm calibrate``);
 - `fit_intervals`: `calibrate_uq`, the 90 % intervals' scale and floor (``emaphm calibrate-uq``);
+- `fit_detection`: `calibrate_detection`, the detection thresholds (``data/detection.json``).
 
 The fits load on first use (PEP 562): reading a calibration file needs neither pymoo nor the
 twin, and the monitor model (`emaphm.models`) imports this package.
@@ -46,6 +47,7 @@ _LAZY = {
         "scenarios",
     ),
     "calibrate": "fit_monitor",
+    "calibrate_detection": "fit_detection",
     **dict.fromkeys(("UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"), "fit_intervals"),
 }  # fmt: skip
 
@@ -69,6 +71,7 @@ __all__ = [
     "Scenario",
     "actuator_params",
     "calibrate",
+    "calibrate_detection",
     "calibrate_uq",
     "check_monitor",
     "coefficient_bounds",
@@ -95,6 +98,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
+    from .fit_detection import calibrate_detection
     from .fit_intervals import UQ_ABSENT, UQ_CASE_SEED, UQ_CASES, calibrate_uq, collect_cases
     from .fit_monitor import calibrate
     from .scenarios import (
