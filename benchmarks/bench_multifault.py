@@ -48,10 +48,10 @@ from _machine import cpu_model  # benchmarks/ is the script's folder, first on s
 import emaphm
 from emaphm.actuator import resolve_params
 from emaphm.calibration import params_hash
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.identify import SECOND_SEARCH_NRMSE, FaultIdentifier
 from emaphm.identification.signals import nrmse as nrmse_of
 from emaphm.identification.switching import LAST_STAGES, SwitchingModel

@@ -24,9 +24,9 @@ import numpy as np
 from bench_multifault import noise_seed_of  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.identify import FaultIdentifier, parse_error_corner, search_to_faults
 from emaphm.identification.optimizers import OptimizerRun, polish
 from emaphm.models import HighFidelityEma, MonitorEma

@@ -35,10 +35,10 @@ import itertools
 
 import numpy as np
 
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS, FIT_SCENARIOS
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS, FIT_SCENARIOS
 from emaphm.identification.fitness import (
     ERROR_CORNER_HZ,
     Fitness,

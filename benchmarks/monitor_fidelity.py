@@ -25,9 +25,9 @@ import numpy as np
 from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.models import HighFidelityEma, MonitorEma
 
 

@@ -37,8 +37,8 @@ import numpy as np
 from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.faults import random_faults
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.identify import FaultIdentifier, recentre_phase, search_to_faults
 from emaphm.identification.metrics import percent_error
 from emaphm.identification.switching import SwitchingModel, space_mapping

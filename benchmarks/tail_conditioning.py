@@ -49,10 +49,10 @@ from _machine import cpu_model  # benchmarks/ is the script's folder, first on s
 from scipy.stats import spearmanr
 
 import emaphm
+from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.commands import Command
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.calibrate import CALIBRATION_COMMANDS
 from emaphm.identification.switching import SWITCHING_STEPS, SwitchingModel
 from emaphm.kernels.transforms import phase_directions
 from emaphm.models import HighFidelityEma, MonitorEma

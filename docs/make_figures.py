@@ -14,7 +14,7 @@ from pathlib import Path
 
 import emaphm
 from emaphm.calibration import Calibration, Coefficients
-from emaphm.identification.calibrate import CHECK_SCENARIOS, FIT_SCENARIOS
+from emaphm.calibration.scenarios import CHECK_SCENARIOS, FIT_SCENARIOS
 from emaphm.models import MonitorEma
 from emaphm.plots import plot_calibration, plot_response
 

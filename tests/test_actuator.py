@@ -13,8 +13,9 @@ import pytest
 from emaphm import EmaParams, InputError
 from emaphm.actuator import ACCEPTED, load_params, params_from_dict, params_template
 from emaphm.calibration import COEFFICIENT_BOUNDS, Coefficients, coefficient_bounds, params_hash
+from emaphm.calibration.fit_monitor import calibrate
+from emaphm.calibration.scenarios import Scenario
 from emaphm.commands import Sine
-from emaphm.identification.calibrate import Scenario, calibrate
 from emaphm.models import MonitorEma
 from emaphm.params import _GROUPS
 from emaphm.units import UNITS

@@ -16,16 +16,16 @@ from emaphm.calibration import (
     load_calibration,
     params_hash,
 )
-from emaphm.commands import make_command
-from emaphm.identification import Comparison
-from emaphm.identification.calibrate import (
+from emaphm.calibration.fit_monitor import calibrate
+from emaphm.calibration.scenarios import (
     CALIBRATION_COMMANDS,
     CHECK_SCENARIOS,
     FIT_SCENARIOS,
     PAPER_CHECK_SCENARIOS,
     PAPER_FIT_SCENARIOS,
-    calibrate,
 )
+from emaphm.commands import make_command
+from emaphm.identification import Comparison
 from tests.helpers import faults
 
 # DESIGN §4 target for the calibrated LF model against the HF twin (filtered i_q, noise off), on
@@ -240,8 +240,8 @@ def test_a_calibration_file_must_say_a_known_monitor_and_a_paper_one_has_no_surr
 
 
 def test_a_calibration_can_name_its_own_commands():
+    from emaphm.calibration.scenarios import Scenario
     from emaphm.commands import Sine
-    from emaphm.identification.calibrate import Scenario
 
     rig = {"rig": Sine(amplitude=0.01, frequency=3.0, duration=0.3)}
     fit = [Scenario("healthy on the rig", emaphm.HEALTHY, "rig")]
@@ -394,8 +394,8 @@ def test_no_zero_vector_holds_beyond_the_ring_edge_at_any_angle():
 
 
 def test_a_calibration_can_fit_a_subset_and_hold_the_rest_at_a_given_calibration():
+    from emaphm.calibration.scenarios import Scenario
     from emaphm.commands import Sine
-    from emaphm.identification.calibrate import Scenario
 
     rig = {"rig": Sine(amplitude=0.002, frequency=3.0, duration=0.3)}
     fit = [Scenario("a short on the rig", faults(k4=0.3), "rig")]

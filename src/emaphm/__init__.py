@@ -37,7 +37,7 @@ _LAZY = {
     "identify": "identification.api", "IdentifySettings": "identification.settings",
     "percent_error": "identification.metrics", "absolute_errors": "identification.metrics",
     "detect": "identification.detection",
-    "calibrate": "identification.calibrate",
+    "calibrate": "calibration.fit_monitor",
     "Calibration": "calibration", "load_calibration": "calibration",
     "read_trace": "io", "write_trace": "io",
     "HighFidelityEma": "models", "MonitorEma": "models", "simulate": "models",
@@ -104,10 +104,10 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from .calibration import Calibration, load_calibration
+    from .calibration.fit_monitor import calibrate
     from .commands import Chirp, ChirpHold, Ramp, Sine, Step, Steps, make_command
     from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
     from .identification.api import identify
-    from .identification.calibrate import calibrate
     from .identification.detection import detect
     from .identification.identifier import FaultIdentifier
     from .identification.metrics import absolute_errors, percent_error

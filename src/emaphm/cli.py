@@ -366,7 +366,7 @@ def calibrate(
     """Re-run the LF calibration against the HF twin (of the actuator file) and write the calibration file."""
     from .actuator import resolve_params
     from .calibration import load_calibration
-    from .identification.calibrate import calibrate as run_calibration
+    from .calibration.fit_monitor import calibrate as run_calibration
     from .io import check_output_path
     from .models import check_seed
 
@@ -409,7 +409,7 @@ def calibrate_uq(
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from .actuator import resolve_params
-    from .identification.calibrate_uq import calibrate_uq as run_calibrate_uq
+    from .calibration.fit_intervals import calibrate_uq as run_calibrate_uq
     from .io import check_output_path
     from .models import MonitorEma, check_seed
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import emaphm
+from emaphm import InputError
 from emaphm.faults import HEALTHY
 from emaphm.identification.detection import DETECTABLE, detect, load_thresholds
 
@@ -37,3 +38,30 @@ def test_detection_rule():
     k[6] = 0.9  # a phase alone is never a fault
     k[7] = 0.44  # gain drift counts either way from 0.5
     assert detect(k, thresholds) == ["friction", "short_b", "kp_drift"]
+
+
+def test_the_loaded_thresholds_are_read_only_and_a_change_cannot_poison_the_next_load():
+    data = load_thresholds()
+    with pytest.raises(TypeError):
+        data["thresholds"]["friction"] = 1.0  # type: ignore[index]
+    with pytest.raises(TypeError):
+        data["monitor"] = "paper"  # type: ignore[index]
+    with pytest.raises(AttributeError):
+        data["healthy_estimates_check_set"].append([0.0] * 8)  # type: ignore[attr-defined]
+    assert load_thresholds()["thresholds"]["friction"] == data["thresholds"]["friction"] < 1.0
+
+
+def test_a_thresholds_file_is_checked(tmp_path):
+    path = tmp_path / "t.json"
+    path.write_text('{"thresholds": {"friction": 0.01}}')
+    with pytest.raises(
+        InputError, match=r"t.json: detection thresholds must name exactly friction, backlash"
+    ):
+        load_thresholds(path)
+    path.write_text(
+        '{"thresholds": {"friction": -1, ' + ", ".join(f'"{n}": 0.01' for n in DETECTABLE[1:]) + "}}"
+    )
+    with pytest.raises(InputError, match="friction=-1 must be a number >= 0"):
+        load_thresholds(path)
+    with pytest.raises(InputError, match="no such thresholds file"):
+        load_thresholds(tmp_path / "none.json")

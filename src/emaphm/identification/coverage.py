@@ -2,7 +2,7 @@
 
 The monitor's coefficients are fitted and checked on a few commands (the packaged calibration:
 fitted on the FDI chirp of DESIGN §6 and a staircase of steps, checked also on that chirp run on
-for 2 s and on the chirp followed by a hold; `identification.calibrate.CALIBRATION_COMMANDS`). A trace recorded under another command, or
+for 2 s and on the chirp followed by a hold; `calibration.scenarios.CALIBRATION_COMMANDS`). A trace recorded under another command, or
 running on beyond them, is still identified, but nothing has measured how well: before the
 monitor was calibrated on them, a 2 s chirp gave 13 %err and the chirp followed by a hold
 28–69 %err with the short in the wrong phase, where the calibrated 1 s chirp gave about 3. Such a

@@ -122,6 +122,8 @@ class IdentifySettings:
                     f"unknown {f.name.replace('_', ' ')} {value!r}; use one of {', '.join(choices)}"
                 )
         _check_int("seed", self.seed, 0, MAX_SEED, "a whole number in 0..2^63-1")
+        if self.workers is None:  # the API's "all cores", as 0
+            object.__setattr__(self, "workers", 0)
         _check_int("workers", self.workers, 0, 4096, "0 (all cores) or a number of threads")
         _check_int("pop_size", self.pop_size, 4, 10**6, "at least 4", none=True)
         _check_int("generations", self.generations, 1, 10**6, "at least 1", none=True)

@@ -1,11 +1,9 @@
-"""Calibration of the LF monitor model: its coefficients and the versioned file that holds them.
+"""The calibration file of the LF monitor model: `Calibration`, its checks, loaders and digest.
 
-The coefficients are those of the paper §4.2 (DESIGN §4.4): the shape-function coefficients
-k_FS, k_E (k_FT follows from them, see `Coefficients.k_FT`), the equivalent torque and back-EMF
-gains k_t,eq and k_e,eq, plus the inertia J_eq the LF model sees and the time constant τ_i of its
-simplified current loop. `emaphm calibrate` fits them with a GA against the HF twin
-(`emaphm.identification.calibrate`); the result ships as ``emaphm/data/calibration.json`` and is
-what the LF model loads by default.
+A `Calibration` holds the coefficients (`emaphm.calibration.coefficients`), the LF step and the
+record of how they were obtained. `emaphm calibrate` writes one (`emaphm.calibration.fit_monitor`);
+the packaged ones ship as ``emaphm/data/calibration.json`` (and ``calibration-paper.json`` for the
+paper's monitor) and are what the LF model loads by default.
 
 A calibration belongs to one actuator: it records the parameters it was fitted for
 (``settings.params``) and their digest (``params_hash``, `params_hash`). `MonitorEma` refuses
@@ -17,29 +15,29 @@ out of the comparison and of the digest.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
 import hashlib
 import json
-import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._data import read_package_json
-from .errors import InputError
-from .params import EmaParams
+from .._data import read_package_json
+from ..errors import InputError
+from ..params import EmaParams
+from .coefficients import COEFFICIENT_BOUNDS, SURROGATE, Coefficients
 
 __all__ = [
-    "COEFFICIENT_BOUNDS",
-    "NAMEPLATE_SCALED",
+    "MONITOR_FILES",
     "Calibration",
-    "Coefficients",
     "actuator_params",
     "check_monitor",
-    "coefficient_bounds",
     "default_calibration",
+    "held_coefficients",
     "load_calibration",
     "params_hash",
 ]
@@ -52,156 +50,6 @@ FORMAT_VERSION = 5
 # dead zone at standstill): its coefficients are the same model with those at 0, read as such
 OLDER_VERSIONS_LACK: dict[int, tuple[str, ...]] = {3: ("i_R", "i_D"), 4: ("i_D",)}
 READABLE_VERSIONS = (*OLDER_VERSIONS_LACK, FORMAT_VERSION)
-
-# GA search bounds of each calibrated coefficient (SI)
-COEFFICIENT_BOUNDS: dict[str, tuple[float, float]] = {
-    "k_FS": (0.0, 100.0),  # [-]
-    "k_E": (0.0, 3.0),  # [-]
-    "k_t_eq": (0.10, 0.20),  # [N·m/A]
-    "k_e_eq": (0.05, 0.20),  # [V·s/rad]
-    "J_eq": (4.0e-5, 6.5e-5),  # [kg·m²]
-    "tau_i": (1e-6, 3e-4),  # [s]
-    "k_H": (-0.1, 0.1),  # [-]
-    "delta_0": (0.0, 0.02),  # [A]
-    "delta_1": (0.0, 0.1),  # [A]
-    "delta_u": (-0.05, 0.1),  # [A]
-    "delta_2": (-0.05, 0.05),  # [A]
-    "V_H": (1e-4, 0.05),  # [V]
-    # [A]; the q current's ripple peak cannot exceed the hysteresis band's width h (0.1 A here):
-    # scaled with the actuator's h (`coefficient_bounds`)
-    "i_R": (0.0, 0.1),
-    # [A]; the half-band of the loop's dead zone at standstill: h/2 in the twin's comparators, up
-    # to h for what the monitor's averaged loop needs; scaled with the actuator's h too
-    "i_D": (0.0, 0.1),
-}
-
-
-@dataclass(frozen=True)
-class Coefficients:
-    """Equivalent single-phase motor and shape-function coefficients.
-
-    The defaults are the first guess before calibration: nameplate gains (k_t,eq = 1.5·p·ψ_m,
-    k_e,eq = p·ψ_m, J_eq = J_m + J_u/τ²), unit shape coefficients, a one-sample current lag and
-    no current-loop surrogate error.
-
-    k_FS : float  single-phase contribution of the short-circuit shape function [-]
-    k_E : float  eccentricity calibration coefficient [-]
-    k_t_eq : float  equivalent torque gain (healthy, φ_T = 1) [N·m/A]
-    k_e_eq : float  equivalent back-EMF coefficient (healthy) [V·s/rad]
-    J_eq : float  inertia at the motor shaft seen by the LF model [kg·m²]
-    tau_i : float  time constant of the simplified current loop [s]
-    k_H : float  2θ_e ripple of the loop's current per unit of lost turns [-]
-    delta_0 : float  loop offset of the measured current, healthy [A]
-    delta_1 : float  growth of that offset per unit of lost turns Σ(1 − N_x) [A]
-    delta_u : float  growth of that offset with the unbalance of the lost turns |U| (kernels.monitor.unbalance) [A]
-    delta_2 : float  part of that offset in step with the shorted phases' 2θ_e pattern c₂ [A]
-    V_H : float  q-axis voltage (R_eq·i + k_e,eq·ω_m) over which the offset reverses its sign [V]
-    i_R : float  peak of the loop's current ripple about i_m that breaks a stuck motor away [A]
-    i_D : float  half-band of the loop's dead zone at standstill (kernels.monitor.standstill_dead_zone) [A]
-    """
-
-    k_FS: float = 1.0
-    k_E: float = 1.0
-    k_t_eq: float = 0.15
-    k_e_eq: float = 0.10
-    J_eq: float = 5.125e-5
-    tau_i: float = 1e-4
-    k_H: float = 0.0
-    delta_0: float = 0.0
-    delta_1: float = 0.0
-    delta_u: float = 0.0
-    delta_2: float = 0.0
-    V_H: float = 0.01
-    i_R: float = 0.0
-    i_D: float = 0.0
-
-    def __post_init__(self) -> None:
-        # the nameplate-scaled coefficients, i_R and i_D are checked against their actuator's box by
-        # `check_bounds`; here only that they are positive (i_R, i_D: not negative)
-        for name, (lo, hi) in COEFFICIENT_BOUNDS.items():
-            v = getattr(self, name)
-            if name in ACTUATOR_SCALED:
-                lo, hi = 0.0, math.inf
-                ok = (
-                    isinstance(v, (int, float))
-                    and math.isfinite(v)
-                    and (v > 0 or (name in BAND_SCALED and v == 0))
-                )
-            else:
-                ok = isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi
-            if not ok:
-                raise InputError(
-                    f"calibration coefficient {name}={v!r} is outside its range [{lo:g}, {hi:g}]"
-                )
-
-    @classmethod
-    def first_guess(cls, params: EmaParams | None = None) -> Coefficients:
-        """The coefficients before calibration for an actuator: the defaults with its nameplate k_t, k_e, J."""
-        nominal, ratio = cls(), _nameplate_ratios(params)
-        return cls(**{name: getattr(nominal, name) * r for name, r in ratio.items()})
-
-    def check_bounds(self, params: EmaParams | None = None, *, where: str = "calibration") -> None:
-        """`InputError` unless every coefficient lies in `coefficient_bounds(params)`."""
-        for name, (lo, hi) in coefficient_bounds(params).items():
-            v = getattr(self, name)
-            if not lo <= v <= hi:
-                raise InputError(
-                    f"{where}: coefficient {name}={v!r} is outside its range [{lo:.4g}, {hi:.4g}]"
-                    + (" for these actuator parameters" if name in ACTUATOR_SCALED else "")
-                )
-
-    @property
-    def k_FT(self) -> float:
-        """Global short-circuit coefficient, k_FT = 1/(3 + 1.5·k_FS) so that a healthy φ_SC = 1.
-
-        k_FT multiplies k_t,eq and k_e,eq everywhere it appears, so the GA would only see their
-        products; fixing φ_SC(healthy) = 1 removes that degenerate direction and makes k_t,eq
-        the healthy torque constant.
-        """
-        return 1.0 / (3.0 + 1.5 * self.k_FS)
-
-    def as_vector(self) -> list[float]:
-        return [float(getattr(self, n)) for n in COEFFICIENT_BOUNDS]
-
-    @classmethod
-    def from_vector(cls, x: Any) -> Coefficients:
-        return cls(**{n: float(v) for n, v in zip(COEFFICIENT_BOUNDS, x, strict=True)})
-
-
-# the coefficients whose search box scales with the actuator's nameplate value (k_t = 1.5·p·ψ_m,
-# k_e = p·ψ_m, J = J_m + J_u/τ²): COEFFICIENT_BOUNDS holds their box for the nominal actuator
-NAMEPLATE_SCALED = ("k_t_eq", "k_e_eq", "J_eq")
-# the coefficients whose box scales with the actuator's hysteresis band h (and may be 0)
-BAND_SCALED = ("i_R", "i_D")
-# all the coefficients whose box follows the actuator
-ACTUATOR_SCALED = (*NAMEPLATE_SCALED, *BAND_SCALED)
-
-
-def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float, float]]:
-    """The calibration's search box for an actuator (`COEFFICIENT_BOUNDS` for the nominal one).
-
-    k_t,eq, k_e,eq and J_eq keep the nominal box's ratios to the nameplate k_t, k_e and J, so a
-    motor with twice the flux, say, is searched around its own constants, and i_R its ratio to
-    the hysteresis band h; the dimensionless shape coefficients and the loop surrogate keep their
-    boxes.
-    """
-    ratio = _nameplate_ratios(params)
-    return {
-        name: (lo * ratio[name], hi * ratio[name]) if name in ratio else (lo, hi)
-        for name, (lo, hi) in COEFFICIENT_BOUNDS.items()
-    }
-
-
-def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
-    """k_t, k_e, J and the band h of `params` over the nominal actuator's (exactly 1 for the nominal one)."""
-    nominal = EmaParams()
-    params = params if params is not None else nominal
-    return {
-        "k_t_eq": params.motor.k_t / nominal.motor.k_t,
-        "k_e_eq": params.motor.k_e / nominal.motor.k_e,
-        "J_eq": params.transmission.J / nominal.transmission.J,
-        **{name: params.inverter.h / nominal.inverter.h for name in BAND_SCALED},
-    }
 
 
 def actuator_params(params: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -295,7 +143,7 @@ class Calibration:
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the calibration file atomically (JSON)."""
-        from .io import atomic_path
+        from ..io import atomic_path
 
         p = Path(path)
         if not p.parent.is_dir():
@@ -307,7 +155,7 @@ class Calibration:
 
 def _command_of(record: Any) -> Any:
     """The command a `command_record` describes (None if it is missing, sampled or not buildable)."""
-    from .commands import make_command
+    from ..commands import make_command
 
     rec = dict(record) if isinstance(record, dict) else {}
     kind = rec.pop("type", None)
@@ -385,11 +233,6 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
 MONITOR_FILES = {"default": "calibration.json", "paper": "calibration-paper.json"}
 
 
-# the loop-error surrogate's coefficients, the loop's breakaway ripple and its dead zone, which
-# the paper's monitor holds at zero (V_H, a scale, has no effect then)
-SURROGATE = ("k_H", "delta_0", "delta_1", "delta_u", "delta_2", "i_R", "i_D")
-
-
 def check_monitor(monitor: Any) -> str:
     """`monitor` if it names a packaged monitor model, else `InputError`."""
     if not isinstance(monitor, str) or monitor not in MONITOR_FILES:
@@ -397,11 +240,56 @@ def check_monitor(monitor: Any) -> str:
     return monitor
 
 
-@functools.lru_cache(maxsize=len(MONITOR_FILES))
 def default_calibration(monitor: str = "default") -> Calibration:
-    """The calibration shipped with the package for `monitor` (``emaphm/data/calibration*.json``), read once."""
-    name = MONITOR_FILES[check_monitor(monitor)]
+    """The calibration shipped with the package for `monitor` (``emaphm/data/calibration*.json``).
+
+    The file is read once; each call returns its own copy of the record, so that a caller that
+    changes it cannot change what the next one gets (the coefficients are frozen).
+    """
+    cal = _packaged(check_monitor(monitor))
+    return dataclasses.replace(cal, record=copy.deepcopy(cal.record))
+
+
+@functools.lru_cache(maxsize=len(MONITOR_FILES))
+def _packaged(monitor: str) -> Calibration:
+    name = MONITOR_FILES[monitor]
     cal = _parse(read_package_json(name), f"emaphm/data/{name}")
     if cal.monitor != monitor:
         raise InputError(f"emaphm/data/{name} holds the {cal.monitor!r} monitor, not {monitor!r}")
     return cal
+
+
+def held_coefficients(
+    free: Sequence[str] | None, start: Calibration | None, monitor: str, params: EmaParams, n_lf: int = 1
+) -> tuple[Coefficients, str]:
+    """The coefficients a calibration starts from and holds where it does not fit, and what they are.
+
+    The first guess without `free`; with it, `start` or the packaged calibration (of the nominal
+    actuator only: another actuator's must be given). `start` must be of the same monitor,
+    actuator and LF step (`n_lf`), and comes only with `free`.
+    """
+    if start is not None and free is None:
+        raise InputError("a calibration to start from needs the coefficients to fit (free=, --free)")
+    if start is None and free is None:
+        return Coefficients.first_guess(params), "first guess"
+    if start is None:
+        if params_hash(params) != params_hash(EmaParams()):
+            raise InputError(
+                "fitting some coefficients of another actuator needs its own calibration to start "
+                "from (start=, --start)"
+            )
+        start = default_calibration(monitor)
+        label = "packaged"
+    else:
+        label = "given"
+    if start.monitor != monitor:
+        raise InputError(
+            f"the calibration to start from is for the {start.monitor!r} monitor, not {monitor!r}"
+        )
+    start.check_params(params, where="the calibration to start from")
+    if start.n_lf != n_lf:
+        raise InputError(
+            f"the calibration to start from was made with n_lf = {start.n_lf}, this one uses {n_lf}"
+        )
+    made = start.record.get("created", "unknown date")
+    return start.coefficients, f"{label} calibration made {made} ({start.params_hash or 'unbound'})"

@@ -1,12 +1,14 @@
 """Calibration of the 90 % intervals for the monitor's discrepancy (issue 9, item 3; ``emaphm calibrate-uq``).
 
-The Laplace intervals (`uncertainty.laplace`) see the measurement noise only; the monitor's
-discrepancy from the actuator biases every estimate by more than that. This module identifies
-random actuators of the HF twin (noise on) whose truth is known, keeps each estimate with its
-noise-only σ, and fits a scale and a floor per fault (`uncertainty.fit_factors`) so that 90 % of
-the intervals hold with the narrowest median interval. The cases are drawn from a seed of their
-own (`UQ_CASE_SEED`), different from every benchmark's; a third of the faults are truly absent
-(`faults.random_faults(absent=...)`), so that intervals at the bound are calibrated too.
+The Laplace intervals (`identification.uncertainty.laplace`) see the measurement noise only;
+the monitor's discrepancy from the actuator biases every estimate by more than that. This module
+identifies random actuators of the HF twin (noise on) whose truth is known, keeps each estimate
+with its noise-only σ, and fits a scale and a floor per fault
+(`identification.uncertainty.fit_factors`) so that 90 % of the intervals hold with the narrowest
+median interval. The cases are drawn from a seed of their own (`UQ_CASE_SEED`), different from
+every benchmark's; a third of the faults are truly absent (`faults.random_faults(absent=...)`),
+so that intervals at the bound are calibrated too. The fitted `Factors` (with `load_factors`)
+stay in `identification.uncertainty`, which applies them.
 
 The result is tied to the LF calibration it was fitted with (its monitor, date and actuator):
 identification with another calibration falls back to noise-only intervals and says so. Re-run
@@ -25,12 +27,12 @@ import numpy as np
 
 from .._versions import versions
 from ..actuator import resolve_params
-from ..calibration import Calibration
 from ..errors import InputError
 from ..faults import random_faults
+from ..identification.uncertainty import FIT_COVERAGE, Factors, fit_factors
 from ..models import MonitorEma, check_seed
 from ..params import EmaParams
-from .uncertainty import FIT_COVERAGE, Factors, fit_factors
+from .files import Calibration
 
 __all__ = ["UQ_ABSENT", "UQ_CASES", "UQ_CASE_SEED", "calibrate_uq", "collect_cases"]
 
@@ -56,7 +58,7 @@ def collect_cases(
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
     "raw_std"} arrays (one row per case). The draws do not depend on `cases`, so a longer set
     extends a shorter one, and `first` resumes one."""
-    from .api import identify
+    from ..identification.api import identify
 
     K = random_faults(cases, seed, absent=absent)[first:]
     estimates, raw, walls = np.empty_like(K), np.empty_like(K), []
@@ -89,8 +91,8 @@ def calibrate_uq(
 
     `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
     """
-    from .last_stage import resolve_last_stage
-    from .weights import resolve_error_corner
+    from ..identification.last_stage import resolve_last_stage
+    from ..identification.weights import resolve_error_corner
 
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
