@@ -182,11 +182,11 @@ def test_the_last_stage_setting():
     assert resolve_last_stage("switching", "paper") == "switching"
     assert resolve_last_stage("none", "default") == "none"
     assert resolve_last_stage("switching", "default", polish=False) == "none"  # a raw search
-    with pytest.raises(InputError, match="last stage"):
+    with pytest.raises(InputError, match="last.stage"):
         resolve_last_stage("fast", "default")
-    with pytest.raises(InputError, match="last stage"):
+    with pytest.raises(InputError, match="last.stage"):
         FaultIdentifier(last_stage="fast")
-    with pytest.raises(InputError, match="last stage"):
+    with pytest.raises(InputError, match="last.stage"):
         identify([0] * 7 + [0.5], last_stage="fast")
 
 

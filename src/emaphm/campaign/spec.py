@@ -66,6 +66,7 @@ The ``[[actuator]]`` and ``[[fleet]]`` tables are read by `emaphm.campaign.actua
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -85,12 +86,10 @@ __all__ = ["CampaignSpec", "Job", "history_seed", "load_campaign"]
 TOP_KEYS = {"campaign", "identify", "actuator", "fleet"}
 CAMPAIGN_KEYS = {"name", "seeds", "description"}
 # identify() settings a campaign may set, with their checks; file paths resolved to the spec's folder
-IDENTIFY_KEYS = {
-    "optimizer": str, "pop_size": int, "generations": int, "polish": bool, "second_search": bool, "uncertainty": str,
-    "monitor": str, "calibration": Path, "uq_calibration": Path, "params": Path,
-    "error_corner": float,  # "auto", "off" or Hz, as identify --error-corner
-    "last_stage": str,  # "auto", "switching" or "none", as identify --last-stage
-}  # fmt: skip
+# the [identify] table: the fields of `IdentifySettings` but the seed (the campaign draws one per
+# job) and the threads (one per job), and identify's input files, resolved to the campaign's folder
+IDENTIFY_FILES = ("calibration", "uq_calibration", "params")
+NOT_IN_CAMPAIGNS = ("seed", "workers")
 
 
 def history_seed(seed: int, flight: int) -> int:
@@ -191,47 +190,37 @@ def _fail(where: str, message: str) -> InputError:
     return InputError(f"{where}: {message}")
 
 
+def identify_keys() -> list[str]:
+    """The keys an [identify] table may hold (`IdentifySettings`' fields and the input files)."""
+    from ..identification.settings import IdentifySettings
+
+    fields = [f.name for f in dataclasses.fields(IdentifySettings) if f.name not in NOT_IN_CAMPAIGNS]
+    return [*fields, *IDENTIFY_FILES]
+
+
 def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
+    """The [identify] table checked as `IdentifySettings` checks it; the keys given, with their
+    values as identify takes them ("off" -> None) and the files' absolute paths."""
+    from ..identification.settings import IdentifySettings
+
     if not isinstance(data, dict):
         raise _fail(where, "[identify] must be a table")
-    unknown = sorted(set(data) - set(IDENTIFY_KEYS))
+    known = identify_keys()
+    unknown = sorted(set(data) - set(known))
     if unknown:
-        raise _fail(
-            where, f"[identify] unknown key(s) {', '.join(unknown)}; known: {', '.join(IDENTIFY_KEYS)}"
-        )
-    out: dict[str, Any] = {}
-    for key, value in data.items():
-        kind = IDENTIFY_KEYS[key]
-        if key == "error_corner":  # as identify --error-corner; stored as identify takes it
-            from ..identification.settings import parse_error_corner
-
-            try:
-                out[key] = parse_error_corner(value, name="error_corner")
-            except InputError as exc:
-                raise _fail(where, f"[identify] {exc}") from None
-        elif kind is Path:
+        raise _fail(where, f"[identify] unknown key(s) {', '.join(unknown)}; known: {', '.join(known)}")
+    options = {k: v for k, v in data.items() if k not in IDENTIFY_FILES}
+    try:
+        settings = IdentifySettings.from_mapping(options, where="[identify]")
+    except InputError as exc:
+        raise _fail(where, f"[identify] {exc}") from None
+    out: dict[str, Any] = {key: getattr(settings, key) for key in options}
+    for key in IDENTIFY_FILES:
+        if key in data:
+            value = data[key]
             if not isinstance(value, str) or not (folder / value).is_file():
                 raise _fail(where, f"[identify] {key} = {value!r}: no such file")
             out[key] = str((folder / value).resolve())
-        elif kind is int and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
-            raise _fail(where, f"[identify] {key} must be a whole number >= 1, got {value!r}")
-        elif not isinstance(value, kind):
-            raise _fail(where, f"[identify] {key} must be a {kind.__name__}, got {value!r}")
-        else:
-            out[key] = value
-    from ..identification.optimizers import check_optimizer
-    from ..choices import UQ_METHODS
-
-    try:
-        check_optimizer(out.get("optimizer", "ga"))
-    except InputError as exc:
-        raise _fail(where, f"[identify] {exc}") from None
-    if out.get("uncertainty", "laplace") not in UQ_METHODS:
-        raise _fail(where, f"[identify] uncertainty must be one of {', '.join(UQ_METHODS)}")
-    from ..choices import LAST_STAGES
-
-    if out.get("last_stage", "auto") not in LAST_STAGES:
-        raise _fail(where, f"[identify] last_stage must be one of {', '.join(LAST_STAGES)}")
     return out
 
 

@@ -119,7 +119,7 @@ class IdentifySettings:
             value = getattr(self, f.name)
             if choices is not None and not (value is None and f.default is None) and value not in choices:
                 raise InputError(
-                    f"unknown {f.name.replace('_', ' ')} {value!r}; use one of {', '.join(choices)}"
+                    f"unknown {f.name} {value!r}; use one of {', '.join(choices)}"
                 )
         _check_int("seed", self.seed, 0, MAX_SEED, "a whole number in 0..2^63-1")
         if self.workers is None:  # the API's "all cores", as 0
@@ -133,7 +133,7 @@ class IdentifySettings:
                 raise InputError(f"{name} must be true or false, got {getattr(self, name)!r}")
         if not (isinstance(self.rtol, numbers.Real) and 0 <= float(self.rtol) < 1):
             raise InputError(f"rtol must be a number in [0, 1), got {self.rtol!r}")
-        object.__setattr__(self, "error_corner", parse_error_corner(self.error_corner))
+        object.__setattr__(self, "error_corner", parse_error_corner(self.error_corner, "error_corner"))
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any], *, where: str = "settings") -> IdentifySettings:
