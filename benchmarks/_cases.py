@@ -21,7 +21,6 @@ from _machine import cpu_model
 import emaphm
 
 # --- emaphm internals: the only place the benchmarks reach past the public API ------------------
-from emaphm._versions import versions
 from emaphm.actuator import load_params, resolve_params
 from emaphm.calibration import params_hash
 from emaphm.campaign.store import RESULT_COLUMNS
@@ -61,7 +60,6 @@ __all__ = [
     "simulate_lf",
     "simulate_lf_many",
     "spread",
-    "versions",
 ]
 
 

@@ -56,6 +56,7 @@ from _cases import (  # benchmarks/ is the script's folder, first on sys.path
     measure,
     params_hash,
     resolve_params,
+    spread,
 )
 
 import emaphm
@@ -165,18 +166,13 @@ def main(argv: list[str] | None = None) -> None:
                   flush=True)  # fmt: skip
     n = len(errs)
     print()
-    print(f"LF-vs-HF NRMSE at the truth: median {100 * statistics.median(nrmses):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses, 90)):.2f} %, max {100 * max(nrmses):.2f} %")  # fmt: skip
-    print(f"the same over the compared samples: median {100 * statistics.median(nrmses_cmp):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses_cmp, 90)):.2f} %, max {100 * max(nrmses_cmp):.2f} %")  # fmt: skip
-    print(f"the switching model against the twin there: median {100 * statistics.median(nrmses_switching):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses_switching, 90)):.2f} %, max {100 * max(nrmses_switching):.2f} %")  # fmt: skip
-    print(f"%err over {n} runs: median {statistics.median(errs):.2f}, p90 {float(np.percentile(errs, 90)):.2f}, "
-          f"max {max(errs):.2f}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
+    print(f"LF-vs-HF NRMSE at the truth: {spread(nrmses, 100, ' %')}")  # fmt: skip
+    print(f"the same over the compared samples: {spread(nrmses_cmp, 100, ' %')}")  # fmt: skip
+    print(f"the switching model against the twin there: {spread(nrmses_switching, 100, ' %')}")  # fmt: skip
+    print(f"%err over {n} runs: {spread(errs)}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
     print(f"wrong basins (the search's fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
           f"runs whose estimate fits better than the truth (model bias): {bias_runs} of {n}")  # fmt: skip
-    print(f"fit NRMSE over the compared samples: median {100 * statistics.median(fits):.2f} %, "
-          f"p90 {100 * float(np.percentile(fits, 90)):.2f} %, max {100 * max(fits):.2f} %; "
+    print(f"fit NRMSE over the compared samples: {spread(fits, 100, ' %')}; "
           f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[args.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
     print(f"switching last stage ({args.last_stage}) moved the estimate in {stage_taken} of {n} runs")
     print(f"wall time per identification: median {statistics.median(walls):.1f} s, max {max(walls):.1f} s")
