@@ -2,6 +2,9 @@
 
     python benchmarks/bench_campaign.py [--jobs 16] [--tiny 60] [--case-seed 5101]
 
+Smallest run (the smoke test): ``--jobs 2 --tiny 2 --pop-size 4 --generations 1 --no-polish``.
+Reported in BENCHMARKS.md, "Fleet campaigns".
+
 1. Throughput. --jobs random multi-fault actuators on the twin (DESIGN §7 ranges, the script's own
    seed), each identified as ``emaphm identify --true-faults K --seed 1`` does (default budget,
    Laplace intervals), run twice: a plain serial loop in this process on one numba thread, and
@@ -18,18 +21,14 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from _cases import add_settings, budget_text, draw_cases, machine_line  # benchmarks/ is first on sys.path
 
-import emaphm
-from emaphm.campaign import ResultStore, load_campaign, run_campaign
-from emaphm.campaign.jobs import run_job
-from emaphm.faults import random_faults
+from emaphm.campaign import ResultStore, load_campaign, run_campaign, run_job
 
 
 def spec_file(folder: Path, name: str, cases: np.ndarray, identify: str = "") -> Path:
@@ -41,18 +40,23 @@ def spec_file(folder: Path, name: str, cases: np.ndarray, identify: str = "") ->
     return path
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=16)
     parser.add_argument("--tiny", type=int, default=60)
     parser.add_argument("--case-seed", type=int, default=5101)
-    args = parser.parse_args()
+    add_settings(parser)
+    args = parser.parse_args(argv)
     cores = len(os.sched_getaffinity(0))
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {cores} cores ({cpu_model()}); "
-          f"{args.jobs} jobs (seed {args.case_seed}), {args.tiny} tiny jobs")  # fmt: skip
+    print(
+        machine_line(f"{args.jobs} jobs (seed {args.case_seed}), {args.tiny} tiny jobs, {budget_text(args)}")
+    )
+    identify = "".join(f"{key} = {value}\n" for key, value in (("pop_size", args.pop_size),
+                       ("generations", args.generations)) if value is not None)  # fmt: skip
+    identify += "polish = false\n" if not args.polish else ""
     with tempfile.TemporaryDirectory() as name:
         tmp = Path(name)
-        spec = spec_file(tmp, "bench", random_faults(args.jobs, args.case_seed))
+        spec = spec_file(tmp, "bench", draw_cases(args.jobs, args.case_seed), identify)
         jobs = load_campaign(spec).jobs()
         run_job(jobs[0].to_dict())  # compile cache loaded, as the campaign's warm-up does
         t0 = time.perf_counter()
@@ -78,7 +82,7 @@ def main() -> None:
               f"jobs at once slow each other); busy share of the {summary.workers} workers "
               f"{own_c / (loop * summary.workers):.3f}")  # fmt: skip
 
-        tiny = spec_file(tmp, "tiny", random_faults(args.tiny, args.case_seed + 1),
+        tiny = spec_file(tmp, "tiny", draw_cases(args.tiny, args.case_seed + 1),
                          'pop_size = 4\ngenerations = 1\npolish = false\nuncertainty = "none"\n')  # fmt: skip
         small = run_campaign(tiny, tmp / "store", workers=cores)
         own = sum(r["wall_time_s"] for r in ResultStore(tmp / "store").read("results", "tiny").to_pylist())

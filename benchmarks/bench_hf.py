@@ -1,9 +1,11 @@
 """HF twin speed: wall seconds per simulated second on one thread (DESIGN §9).
 
-Target ≤ 0.15 s, goal ≤ 0.05 s. Run:
+Target ≤ 0.15 s, goal ≤ 0.05 s. Reported in BENCHMARKS.md, "HF twin speed". Run:
 
     python benchmarks/bench_hf.py [--repeats 5]
     python benchmarks/bench_hf.py --batch 40 [--repeats 5]
+
+Smallest run (the smoke test): ``--repeats 1`` and ``--batch 2 --repeats 1``.
 
 The first call loads (or compiles) the numba kernels and is reported apart; the figure is the
 median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs), and
@@ -20,13 +22,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import time
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one thread, as the target states
 
 import numpy as np
+from _cases import draw_cases, machine_line  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
 
@@ -37,11 +39,11 @@ CASES = {
 }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--batch", type=int, default=0, help="N: time a batch of N runs on 1 and 2 threads")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     if args.batch:
         batch(args)
         return
@@ -49,10 +51,7 @@ def main() -> None:
     t0 = time.perf_counter()
     emaphm.simulate(emaphm.HEALTHY, duration=0.01)
     first = time.perf_counter() - t0
-    print(
-        f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {platform.machine()}, "
-        f"{os.cpu_count()} cores, NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}"
-    )
+    print(machine_line(f"NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}"))
     print(f"first call (import of kernels: compile or cache load): {first:.2f} s")
     dt = emaphm.EmaParams().integration.dt
     print(
@@ -79,13 +78,14 @@ def main() -> None:
 
 def batch(args: argparse.Namespace) -> None:
     """`simulate_batch` of args.batch random rows on 1 thread and on 2, alternating."""
-    from emaphm.faults import random_faults
-
-    K = random_faults(args.batch, 9002)
+    K = draw_cases(args.batch, 9002)
     twin = emaphm.HighFidelityEma()
     twin.simulate_batch(K[:2], noise=False, workers=2)  # compile or cache load
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores; "
-          f"simulate_batch of {args.batch} random rows (seed 9002), noise off, {args.repeats} rounds")  # fmt: skip
+    print(
+        machine_line(
+            f"simulate_batch of {args.batch} random rows (seed 9002), noise off, {args.repeats} rounds"
+        )
+    )
     walls: dict[int, list[float]] = {1: [], 2: []}
     for _ in range(args.repeats):
         for workers in (1, 2):

@@ -2,9 +2,12 @@
 
     python benchmarks/bench_multifault.py [--cases 40] [--seeds 2] [--restarts 3] [--case-seed 2611]
                                           [--monitor default|paper] [--command chirp|chirp-2s|chirp-hold|steps]
-                                          [--starts 2 --pop-size 64 --generations 30]
-                                          [--params ACTUATOR.toml --calibration CAL.json] [--best-from EARLIER.txt]
+                                          [--params ACTUATOR.toml --calibration CAL.json]
                                           [--last-stage auto|switching|none]
+
+Smallest run (the smoke test): ``--cases 1 --seeds 1 --restarts 0 --pop-size 4 --generations 1
+--no-polish --last-stage none``. Reported in BENCHMARKS.md, "Multi-fault identification" (and
+"Another actuator" with --params/--calibration).
 
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) drawn from --case-seed, a seed of this
 script's own (the calibration and `bench_identify.py` use others). Each case is identified with
@@ -12,12 +15,11 @@ seeds 1..--seeds exactly as ``emaphm identify --true-faults K --seed S`` does: s
 into the twin's noise seed (a fresh measurement per seed) and the optimiser's seed. --command runs
 the twin under another of the calibration's commands (the trace is then identified as a recording,
 ``emaphm identify --reference``); --monitor picks the monitor model (the paper's, eqs. 1-2 alone, or
-the default one). --starts N runs N independent identifications per measurement (optimiser seeds
-s, 5000 + s, ...; each with --pop-size x --generations and its polish) and keeps the best: a
-candidate search scheme against wrong basins (BENCHMARKS.md), not what `emaphm identify` does.
---params and --calibration run another actuator (an actuator file, issue 10) on its own twin with
-its own calibration (``emaphm calibrate --params``). --last-stage is identify's (the switching
-last stage, `emaphm.identification.switching`; "auto": with the default monitor).
+the default one). --params and --calibration run another actuator (an actuator file, issue 10) on
+its own twin with its own calibration (``emaphm calibrate --params``). --last-stage is identify's
+(the switching last stage, `emaphm.identification.last_stage`; "auto": with the default monitor).
+The research flags --starts and --best-from are gone (last at dae85bf; their figures are in
+benchmarks/results/HISTORY.md).
 
 Printed per case and in summary:
 - LF-vs-HF NRMSE at the truth (noise off, 150 Hz filtered): the monitor's bias for that actuator,
@@ -26,10 +28,9 @@ Printed per case and in summary:
   against the twin over the compared samples;
 - %err of each run, median / p90 / max over all runs, and runs above 10 %err;
 - wrong basins: a run whose search's fitness (the monitor's eq. 3 at the search's estimate, before
-  any last stage) exceeds 1.2x the best fitness found for its measurement
-  by a reference search (the run itself plus --restarts more identifications of the same
-  measurement with other optimiser seeds, plus the best of an earlier output given by
-  --best-from); also the fitness at the true vector, to tell model bias (truth worse than the
+  any last stage) exceeds 1.2x the best fitness found for its measurement by a reference search
+  (the run itself plus --restarts more identifications of the same measurement with other
+  optimiser seeds); also the fitness at the true vector, to tell model bias (truth worse than the
   estimate) from search failure;
 - wall time per identification.
 """
@@ -37,92 +38,64 @@ Printed per case and in summary:
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from _cases import (  # benchmarks/ is the script's folder, first on sys.path
+    BUDGET,
+    CALIBRATION_COMMANDS,
+    SECOND_SEARCH_NRMSE,
+    SampledCommand,
+    SwitchingModel,
+    add_settings,
+    budget_text,
+    draw_cases,
+    machine_line,
+    measure,
+    params_hash,
+    resolve_params,
+    settings_of,
+    spread,
+)
 
 import emaphm
-from emaphm.actuator import resolve_params
-from emaphm.calibration import params_hash
-from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
-from emaphm.commands import SampledCommand
-from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.identify import SECOND_SEARCH_NRMSE, FaultIdentifier
-from emaphm.identification.signals import nrmse as nrmse_of
-from emaphm.identification.switching import LAST_STAGES, SwitchingModel
-from emaphm.models import HighFidelityEma, MonitorEma
+from emaphm.identification import nrmse as nrmse_of
+
+# the identification's settings this benchmark sets (flags made from `IdentifySettings`)
+SETTINGS = (*BUDGET, "optimizer", "monitor", "last_stage")
 
 
-def noise_seed_of(seed: int) -> int:
-    """The twin's noise seed that `identify(true_faults=..., seed=seed)` uses."""
-    return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
-
-
-def fitness_at(trace: emaphm.SimResult, K: np.ndarray, monitor: MonitorEma) -> np.ndarray:
+def fitness_at(trace: emaphm.SimResult, K: np.ndarray, monitor: emaphm.MonitorEma) -> np.ndarray:
     """Eq. (3) fitness of fault rows K on a measured trace: the identification's own objective
     (the same grid, filter and compared samples, `FaultIdentifier.prepare`)."""
     command = SampledCommand(trace.t - trace.t[0], trace.theta_cmd)
-    ident = FaultIdentifier("ga", monitor=monitor).prepare(trace.t, trace.i_q, command, trace.theta_u)
+    ident = emaphm.FaultIdentifier(monitor=monitor).prepare(trace.t, trace.i_q, command, trace.theta_u)
     return ident.objective_.of_monitor(ident.monitor_, K, duration=ident.duration_)
 
 
-def best_from(path: str) -> dict[tuple[int, int], float]:
-    """f_best per (case, seed) from an earlier output of this script (the same measurements: the
-    noise seed follows the seed), to strengthen the reference search of a run with few restarts."""
-    best = {}
-    with open(path) as fh:
-        for line in fh:
-            p = line.split()
-            if len(p) >= 9 and p[0].isdigit() and p[1].endswith("%"):
-                seed_at = 3 if p[2].endswith("%") else 2  # with or without the "cmp" column
-                best[(int(p[0]), int(p[seed_at]))] = float(p[seed_at + 3])
-    return best
-
-
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=40)
     parser.add_argument("--seeds", type=int, default=2)
     parser.add_argument("--restarts", type=int, default=3, help="extra optimiser seeds per measurement")
     parser.add_argument("--case-seed", type=int, default=2611)
-    parser.add_argument("--optimizer", default="ga")
-    parser.add_argument("--monitor", default="default", choices=("default", "paper"))
     parser.add_argument("--command", default="chirp", choices=tuple(CALIBRATION_COMMANDS))
-    parser.add_argument(
-        "--starts",
-        type=int,
-        default=1,
-        help="independent searches per run (seeds s, 5000 + s, ...), the best kept",
-    )
-    parser.add_argument("--pop-size", type=int, default=None, help="population of each search")
-    parser.add_argument("--generations", type=int, default=None, help="generations of each search")
-    parser.add_argument(
-        "--best-from",
-        default=None,
-        help="an earlier output of this script on the same cases and command: its f_best per run joins the reference",
-    )
     parser.add_argument("--params", default=None, help="actuator file (default: the nominal actuator)")
     parser.add_argument("--calibration", default=None, help="its LF calibration (default: the packaged one)")
-    parser.add_argument("--last-stage", default="auto", choices=LAST_STAGES, help="identify's last stage")
-    args = parser.parse_args()
+    add_settings(parser, SETTINGS)
+    args = parser.parse_args(argv)
     params = resolve_params(args.params)
-    cpu = cpu_model()
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
-          f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
-          f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}, "
-          f"{args.starts} start(s) of pop {args.pop_size or 'default'} x {args.generations or 'default'}; "
-          f"actuator {args.params or 'nominal'} ({params_hash(params)}), calibration {args.calibration or 'packaged'}, "
-          f"last stage {args.last_stage}")  # fmt: skip
-    earlier = best_from(args.best_from) if args.best_from else {}
-    cases = random_faults(args.cases, args.case_seed)
+    print(machine_line(
+        f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds, {args.restarts} restarts, "
+        f"optimizer {args.optimizer}, monitor {args.monitor}, command {args.command}, {budget_text(args)}; "
+        f"actuator {args.params or 'nominal'} ({params_hash(params)}), calibration {args.calibration or 'packaged'}, "
+        f"last stage {args.last_stage}"))  # fmt: skip
+    cases = draw_cases(args.cases, args.case_seed)
     command = CALIBRATION_COMMANDS[args.command]
-    monitor = MonitorEma(params, command, args.calibration, monitor=args.monitor)
-    hf = HighFidelityEma(params, command)
+    monitor = emaphm.MonitorEma(params, command, args.calibration, monitor=args.monitor)
+    hf = emaphm.HighFidelityEma(params, command)
     errs, walls, wrong, bias_runs, nrmses, nrmses_cmp = [], [], 0, 0, [], []
     fits, second_runs, second_taken = [], 0, 0
     switching, nrmses_switching, stage_taken = SwitchingModel(params, command), [], 0
@@ -136,7 +109,7 @@ def main() -> None:
         nrmses.append(nrmse)
         # the same over the samples the identification compares (holds at rest and motion above
         # the monitor's band left out; 1 s chirp: all of them)
-        seen = FaultIdentifier("ga", monitor=monitor).prepare(
+        seen = emaphm.FaultIdentifier(monitor=monitor).prepare(
             clean.t, clean.i_q, SampledCommand(clean.t - clean.t[0], clean.theta_cmd), clean.theta_u
         )
         keep = seen.mask_ > 0
@@ -145,29 +118,18 @@ def main() -> None:
         sw_truth = seen.reference_.filtered(switching.current(k, duration=seen.duration_, workers=2))
         nrmses_switching.append(float(nrmse_of(seen.reference_.reference[keep], sw_truth[keep])))
         for s in range(1, args.seeds + 1):
-            trace = hf.simulate(k, noise=True, seed=noise_seed_of(s))
+            trace = measure(k, s, hf)  # as identify(true_faults=k, seed=s) measures it
             t0 = time.perf_counter()
-            starts = [
-                emaphm.identify(
-                    reference=trace, seed=s + 5000 * q, optimizer=args.optimizer, monitor=args.monitor,
-                    pop_size=args.pop_size, generations=args.generations, params=params,
-                    calibration=monitor.calibration, last_stage=args.last_stage,
-                )
-                for q in range(args.starts)
-            ]  # fmt: skip
-            run = min(starts, key=lambda r: r.settings["search_fitness"])
+            run = emaphm.identify(
+                reference=trace, seed=s, params=params, calibration=monitor.calibration, **settings_of(args, SETTINGS)
+            )
             walls.append(time.perf_counter() - t0)
             err = emaphm.percent_error(run.estimate, k)
             errs.append(err)
             others = [
                 emaphm.identify(
-                    reference=trace,
-                    seed=1000 * r + s,
-                    optimizer=args.optimizer,
-                    monitor=args.monitor,
-                    params=params,
-                    calibration=monitor.calibration,
-                    last_stage=args.last_stage,
+                    reference=trace, seed=1000 * r + s, params=params, calibration=monitor.calibration,
+                    **settings_of(args, SETTINGS),
                 ).settings["search_fitness"]
                 for r in range(1, args.restarts + 1)
             ]
@@ -175,11 +137,12 @@ def main() -> None:
             # before any last stage): the switching model's eq. 3 differs by tens of per cent
             # between nearby estimates (its stick-slip is chaotic) and cannot rank them
             f_run = run.settings["search_fitness"]
-            f_best = min([f_run, *others, earlier.get((j, s), np.inf)])
+            f_best = min([f_run, *others])
             f_true = float(fitness_at(trace, k[None, :], monitor)[0])
             is_wrong = f_run > 1.2 * f_best
             fits.append(run.fit_nrmse)
-            second = run.settings["second_search_run"]
+            second = run.stage("second_search")
+            second = second if second["ran"] else None
             second_runs += second is not None
             second_taken += second is not None and second["taken"]
             mark = (
@@ -187,7 +150,7 @@ def main() -> None:
                 if second is None
                 else f"  2nd search {'taken' if second['taken'] else 'not taken'} (first fit {100 * second['first_fit_nrmse']:.2f}%)"
             )
-            stage = run.settings["switching_stage"]
+            stage = run.stage("last_stage")["switching"]
             stage_taken += bool(stage and stage["taken"])
             mark += "" if stage is None else f"  stage {'taken' if stage['taken'] else 'not taken'}"
             wrong += is_wrong
@@ -197,19 +160,14 @@ def main() -> None:
                   flush=True)  # fmt: skip
     n = len(errs)
     print()
-    print(f"LF-vs-HF NRMSE at the truth: median {100 * statistics.median(nrmses):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses, 90)):.2f} %, max {100 * max(nrmses):.2f} %")  # fmt: skip
-    print(f"the same over the compared samples: median {100 * statistics.median(nrmses_cmp):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses_cmp, 90)):.2f} %, max {100 * max(nrmses_cmp):.2f} %")  # fmt: skip
-    print(f"the switching model against the twin there: median {100 * statistics.median(nrmses_switching):.2f} %, "
-          f"p90 {100 * float(np.percentile(nrmses_switching, 90)):.2f} %, max {100 * max(nrmses_switching):.2f} %")  # fmt: skip
-    print(f"%err over {n} runs: median {statistics.median(errs):.2f}, p90 {float(np.percentile(errs, 90)):.2f}, "
-          f"max {max(errs):.2f}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
+    print(f"LF-vs-HF NRMSE at the truth: {spread(nrmses, 100, ' %')}")  # fmt: skip
+    print(f"the same over the compared samples: {spread(nrmses_cmp, 100, ' %')}")  # fmt: skip
+    print(f"the switching model against the twin there: {spread(nrmses_switching, 100, ' %')}")  # fmt: skip
+    print(f"%err over {n} runs: {spread(errs)}; runs above 10 %err: {sum(e > 10 for e in errs)}")  # fmt: skip
     print(f"wrong basins (the search's fitness > 1.2x the best found for the measurement): {wrong} of {n}; "
           f"runs whose estimate fits better than the truth (model bias): {bias_runs} of {n}")  # fmt: skip
-    print(f"fit NRMSE over the compared samples: median {100 * statistics.median(fits):.2f} %, "
-          f"p90 {100 * float(np.percentile(fits, 90)):.2f} %, max {100 * max(fits):.2f} %; "
-          f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[args.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
+    print(f"fit NRMSE over the compared samples: {spread(fits, 100, ' %')}; "
+          f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[monitor.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
     print(f"switching last stage ({args.last_stage}) moved the estimate in {stage_taken} of {n} runs")
     print(f"wall time per identification: median {statistics.median(walls):.1f} s, max {max(walls):.1f} s")
 

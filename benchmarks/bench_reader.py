@@ -2,6 +2,9 @@
 
     python benchmarks/bench_reader.py [--cases 6] [--case-seed 3301] [--part formats|phases|both]
 
+Smallest run (the smoke test): ``--cases 1 --pop-size 4 --generations 1 --no-polish``. Reported in
+BENCHMARKS.md, "Recordings through the reader".
+
 Cases: random multi-fault actuators in the DESIGN §7 ranges (`emaphm.faults.random_faults`, the
 script's own seed), each simulated once on the HF twin with noise on (noise seed = case index).
 
@@ -22,20 +25,22 @@ within 1 deg).
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from _cases import (  # benchmarks/ first
+    add_settings,
+    budget,
+    budget_text,
+    draw_cases,
+    load_params,
+    machine_line,
+)
 
 import emaphm
-from emaphm.actuator import load_params
-from emaphm.faults import random_faults
-from emaphm.models import HighFidelityEma
 
 HERE = Path(__file__).resolve().parent
 FS20K, FS20K_CAL = HERE / "actuators" / "fs20k.toml", HERE / "actuators" / "fs20k.cal.json"
@@ -52,10 +57,13 @@ def write_map(path: Path, entries: dict[str, str]) -> Path:
     return path
 
 
+BUDGET: dict[str, object] = {}  # the identification's budget, set by main from --pop-size etc.
+
+
 def identify(
     reference: Path, seed: int, channel_map: Path | None = None, **kw: object
 ) -> emaphm.IdentificationResult:
-    return emaphm.identify(reference=reference, seed=seed, channel_map=channel_map, **kw)  # type: ignore[arg-type]
+    return emaphm.identify(reference=reference, seed=seed, channel_map=channel_map, **BUDGET, **kw)  # type: ignore[arg-type]
 
 
 def formats(cases: np.ndarray, tmp: Path) -> None:
@@ -129,7 +137,7 @@ def phases(cases: np.ndarray, tmp: Path, seed: int) -> None:
     for j, k in enumerate(cases):
         for name, params, every in setups:
             kw = {} if params is None else {"params": params, "calibration": FS20K_CAL}
-            r = HighFidelityEma(params).simulate(k, seed=j)
+            r = emaphm.HighFidelityEma(params).simulate(k, seed=j)
             native = identify(emaphm.write_trace(r, tmp / "native.h5"), 1, **kw)
             offset = float(rng.uniform(0.0, 360.0))
             t0 = time.perf_counter()
@@ -148,15 +156,17 @@ def phases(cases: np.ndarray, tmp: Path, seed: int) -> None:
               f"offset error max {max(c for _, _, c in rows):.3f} deg")  # fmt: skip
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=6)
     parser.add_argument("--case-seed", type=int, default=3301)
     parser.add_argument("--part", choices=("formats", "phases", "both"), default="both")
-    args = parser.parse_args()
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu_model()}); "
-          f"{args.cases} cases (seed {args.case_seed})")  # fmt: skip
-    cases = random_faults(args.cases, args.case_seed)
+    add_settings(parser)
+    args = parser.parse_args(argv)
+    BUDGET.clear()
+    BUDGET.update(budget(args))
+    print(machine_line(f"{args.cases} cases (seed {args.case_seed}), {budget_text(args)}"))
+    cases = draw_cases(args.cases, args.case_seed)
     with tempfile.TemporaryDirectory() as name:
         if args.part in ("formats", "both"):
             formats(cases, Path(name))

@@ -3,6 +3,10 @@
     emaphm campaign run benchmarks/campaigns/rtf.toml --out STORE      # 285 identifications
     python benchmarks/bench_rul.py STORE [--alpha 0.2] [--lam 0.5] [--estimator trend|ukf]
 
+Smallest run (the smoke test): a store of one actuator flown a few flights with a tiny budget
+(tests/test_benchmarks.py writes its spec), ``STORE --spec SPEC``. Reported in BENCHMARKS.md,
+"Prognostics".
+
 The campaign flies 10 actuators on the HF twin (noise on) whose friction and backlash grow
 linearly from flight 1 (start 0.05 and 0.02, growth drawn per actuator, `rtf.toml`); every flight
 is identified with its 90 % intervals. With the thresholds friction 0.45 and backlash 0.25 the
@@ -31,7 +35,9 @@ import statistics
 import tomllib
 from pathlib import Path
 
-from emaphm.errors import InputError
+from _cases import progpy_model as load_progpy  # benchmarks/ is the script's folder, first on sys.path
+
+from emaphm import InputError
 from emaphm.prognostics import rul_report
 
 HERE = Path(__file__).resolve().parent
@@ -39,18 +45,15 @@ THRESHOLDS = {"friction": 0.45, "backlash": 0.25}
 COLUMN = {"friction": 0, "backlash": 1}
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("store", type=Path)
     parser.add_argument("--spec", type=Path, default=HERE / "campaigns" / "rtf.toml")
     parser.add_argument("--alpha", type=float, default=0.2)
     parser.add_argument("--lam", type=float, default=0.5)
     parser.add_argument("--estimator", default="trend", choices=("trend", "ukf"))
-    args = parser.parse_args()
-    try:
-        from emaphm.prognostics import progpy_model
-    except InputError:
-        progpy_model = None  # type: ignore[assignment]
+    args = parser.parse_args(argv)
+    progpy_model = load_progpy()
     pp_met, pp_ph, pp_cra = 0, [], []
     spec = tomllib.loads(args.spec.read_text())
     met, covered, accuracy, horizons, n = 0, 0, [], [], 0

@@ -6,6 +6,8 @@ Writes a results store with one actuator whose friction grows linearly over --fl
 (each row as a campaign writes it, with its interval and verdicts), then times the whole command
 `emaphm rul STORE --actuator A1 --threshold friction=0.45 --json` (process start included), and
 once with `--plot`. Prints min / median / max wall seconds.
+
+Smallest run (the smoke test): ``--flights 10 --runs 1``. Reported in BENCHMARKS.md, "Prognostics".
 """
 
 from __future__ import annotations
@@ -20,8 +22,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _cases import RESULT_COLUMNS, machine_line  # benchmarks/ is the script's folder, first on sys.path
 
-from emaphm.campaign.store import RESULT_COLUMNS, ResultStore
+from emaphm.campaign import ResultStore
 
 
 def rows(flights: int) -> list[dict]:
@@ -37,11 +40,12 @@ def rows(flights: int) -> list[dict]:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--flights", type=int, default=100)
     parser.add_argument("--runs", type=int, default=5)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    print(machine_line(f"{args.flights} flights, {args.runs} runs"))
     with tempfile.TemporaryDirectory() as name:
         store = Path(name) / "store"
         ResultStore(store).write("results", rows(args.flights))

@@ -3,6 +3,9 @@
     python benchmarks/monitor_fidelity.py [--cases 30] [--case-seed 2027] [--commands chirp,steps]
                                           [--monitors paper,default] [--calibration FILE]
 
+Smallest run (the smoke test): ``--cases 1 --commands chirp``. Reported in BENCHMARKS.md,
+"Monitor fidelity".
+
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) from --case-seed. The default 2027 is the
 draw of the monitor prototype (../shared/notes/monitor-prototype.md), so its figures compare;
 the calibration fits on seeds 3101-3104 and checks on 3201-3204, so no case here was fitted.
@@ -17,32 +20,25 @@ issue 8's 4 % target for the worst case, and the worst case.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import time
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from _cases import CALIBRATION_COMMANDS, draw_cases, machine_line  # benchmarks/ is first on sys.path
 
 import emaphm
-from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
-from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.models import HighFidelityEma, MonitorEma
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=30)
     parser.add_argument("--case-seed", type=int, default=2027)
     parser.add_argument("--commands", default=",".join(CALIBRATION_COMMANDS))
     parser.add_argument("--monitors", default="paper,default")
     parser.add_argument("--calibration", default=None, help="a calibration file, reported as 'file'")
-    args = parser.parse_args()
-    cpu = cpu_model()
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores ({cpu}); "
-          f"{args.cases} cases (seed {args.case_seed}), HF noise off")  # fmt: skip
-    cases = random_faults(args.cases, args.case_seed)
+    args = parser.parse_args(argv)
+    print(machine_line(f"{args.cases} cases (seed {args.case_seed}), HF noise off"))
+    cases = draw_cases(args.cases, args.case_seed)
     monitors = {m: {"monitor": m} for m in args.monitors.split(",") if m}
     if args.calibration:
         monitors["file"] = {"calibration": args.calibration}
@@ -51,12 +47,12 @@ def main() -> None:
     )
     for name in args.commands.split(","):
         command = CALIBRATION_COMMANDS[name]
-        hf = HighFidelityEma(command=command)
+        hf = emaphm.HighFidelityEma(command=command)
         start = time.perf_counter()
         refs = [Comparison.from_signal(r.t, r.i_q, hf.params.controller.f_s)
                 for r in (hf.simulate(k, noise=False) for k in cases)]  # fmt: skip
         for label, how in monitors.items():
-            lf = MonitorEma(command=command, **how)
+            lf = emaphm.MonitorEma(command=command, **how)
             currents = lf.simulate_many(cases)
             v = 100 * np.array([ref.nrmse(i) for ref, i in zip(refs, currents, strict=True)])
             worst = int(np.argmax(v))

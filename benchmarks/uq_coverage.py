@@ -3,6 +3,9 @@
     python benchmarks/uq_coverage.py [--cases 100] [--case-seed 4201] [--absent 0.333]
                                      [--healthy 20] [--uq-calibration FILE] [--uncertainty laplace]
 
+Smallest run (the smoke test): ``--cases 2 --healthy 1 --pop-size 4 --generations 1 --no-polish``.
+Reported in BENCHMARKS.md, "Uncertainty" (and the healthy false detections under "Detection").
+
 Cases: DESIGN §7 ranges (`emaphm.faults.random_faults`) from --case-seed, a seed of this script's
 own (the interval calibration draws from 4101, bench_multifault from 2611); each fault but k7 is
 absent (healthy) with probability --absent, so that spurious detections can be counted. Case i
@@ -24,19 +27,23 @@ Printed, per fault and pooled:
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+from _cases import (  # benchmarks/ first on sys.path
+    add_settings,
+    budget,
+    budget_text,
+    covers,
+    draw_cases,
+    machine_line,
+)
 
 import emaphm
-from emaphm.faults import FAULT_NAMES, HEALTHY, random_faults
-from emaphm.identification.uncertainty import covers
+from emaphm import FAULT_NAMES, HEALTHY
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=100)
     parser.add_argument("--case-seed", type=int, default=4201)
@@ -44,18 +51,20 @@ def main() -> None:
     parser.add_argument("--healthy", type=int, default=20)
     parser.add_argument("--uq-calibration", default=None)
     parser.add_argument("--uncertainty", default="laplace", choices=("laplace", "mcmc"))
-    args = parser.parse_args()
-    print(f"emaphm {emaphm.__version__}, Python {platform.python_version()}, {os.cpu_count()} cores "
-          f"({cpu_model()}); {args.cases} cases (seed {args.case_seed}, absent {args.absent:.3f}), "
-          f"uncertainty {args.uncertainty}, interval calibration {args.uq_calibration or 'packaged'}")  # fmt: skip
-    cases = random_faults(args.cases, args.case_seed, absent=args.absent)
+    add_settings(parser)
+    args = parser.parse_args(argv)
+    print(machine_line(f"{args.cases} cases (seed {args.case_seed}, absent {args.absent:.3f}), "
+                       f"uncertainty {args.uncertainty}, interval calibration {args.uq_calibration or 'packaged'}, "
+                       f"{budget_text(args)}"))  # fmt: skip
+    cases = draw_cases(args.cases, args.case_seed, absent=args.absent)
     inside, scored, half, uq_walls, errs = [], [], [], [], []
     spurious = unsure_zero = zero_faults = found = present_faults = 0
     undefined = small_zeta = 0
     for i, k in enumerate(cases):
         r = emaphm.identify(
-            true_faults=k, seed=i + 1, uncertainty=args.uncertainty, uq_calibration=args.uq_calibration
-        )
+            true_faults=k, seed=i + 1, uncertainty=args.uncertainty, uq_calibration=args.uq_calibration,
+            **budget(args),
+        )  # fmt: skip
         if r.uncertainty is None:
             print(f"{i:>4} does not fit (NRMSE {r.fit_nrmse}): no intervals", flush=True)
             continue
@@ -92,7 +101,8 @@ def main() -> None:
     for j, name in enumerate(FAULT_NAMES):
         s = scored_a[:, j]
         cov = inside_a[s, j].mean() if s.any() else float("nan")
-        print(f"k{j + 1} {name:<17} {cov:>8.3f} {int(s.sum()):>6} {float(np.median(half_a[s, j])):>18.4f}")
+        width = float(np.median(half_a[s, j])) if s.any() else float("nan")
+        print(f"k{j + 1} {name:<17} {cov:>8.3f} {int(s.sum()):>6} {width:>18.4f}")
     pooled = inside_a[scored_a].mean()
     print(f"pooled coverage {pooled:.3f} over {int(scored_a.sum())} intervals of {n} cases; "
           f"%err median {statistics.median(errs):.2f}")  # fmt: skip
@@ -106,7 +116,9 @@ def main() -> None:
     if args.healthy:
         alarms = 0
         for s in range(2000, 2000 + args.healthy):
-            r = emaphm.identify(true_faults=HEALTHY, seed=s, uq_calibration=args.uq_calibration)
+            r = emaphm.identify(
+                true_faults=HEALTHY, seed=s, uq_calibration=args.uq_calibration, **budget(args)
+            )
             alarms += bool(r.detected)
             if r.detected:
                 print(f"healthy seed {s}: reported {', '.join(r.detected)}", flush=True)

@@ -139,7 +139,7 @@ def test_a_masked_fitness_ignores_the_left_out_samples():
 def test_a_fast_recording_is_low_passed_before_it_is_resampled():
     """Issue 10: a 64 kHz current with inverter ripple wandering 12-20 kHz. Interpolated straight
     onto the 10 kHz grid, the ripple folds into the comparison band (7.3 mA RMS measured);
-    filtered on its own grid first, with its edges smoothed, 0.008 mA (benchmarks/bench_resample.py).
+    filtered on its own grid first, with its edges smoothed, 0.008 mA (studies/bench_resample.py).
     A source on the grid or slower is interpolated as it is."""
     from emaphm.identification.signals import resample
 

@@ -1,9 +1,12 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at 7645bb6); rerun it at that
+# commit to reproduce its figures: HISTORY.md (multi-fault sections, --by-frequency: ERROR_CORNER_HZ 2.38
+# Hz); docs/theory/monitor-model.md, docs/identification.md.
 """Where in time the monitor at the true faults errs, against the HF twin (issue 8, item 5).
 
-    python benchmarks/monitor_error_at_truth.py [--command chirp-2s] [--cases 12] [--window 0.25]
+    python studies/monitor_error_at_truth.py [--command chirp-2s] [--cases 12] [--window 0.25]
                                                 [--case-seed 2611] [--only 0,12] [--floor] [--angle]
-    python benchmarks/monitor_error_at_truth.py --by-frequency
-    python benchmarks/monitor_error_at_truth.py --command steps --cases 20 --rest-share
+    python studies/monitor_error_at_truth.py --by-frequency
+    python studies/monitor_error_at_truth.py --command steps --cases 20 --rest-share
 
 
 For each of bench_multifault's random cases (its own seed 2611, noise off), per window of the
@@ -47,7 +50,7 @@ from emaphm.identification.fitness import (
     error_weights,
     moving_mask,
 )
-from emaphm.identification.identify import FaultIdentifier
+from emaphm.identification.identifier import FaultIdentifier
 from emaphm.models import HighFidelityEma, MonitorEma
 
 

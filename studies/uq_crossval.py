@@ -1,6 +1,9 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at 0d70484); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"Uncertainty of a diagnosis", results/uq-crossval-*.txt;
+# docs/uncertainty.md.
 """Cross-validation of the interval calibration on its own cases (issue 9): why it fits to 92 %, not 90 %.
 
-    python benchmarks/uq_crossval.py [--targets 0.90 0.92] [--repeats 5]
+    python studies/uq_crossval.py [--targets 0.90 0.92] [--repeats 5]
 
 Reads the cases stored in the shipped `emaphm/data/uq_calibration.json` (estimates, noise-only
 σ, truths) and, for each training target, fits `uncertainty.fit_factors` on 3 of 4 folds and

@@ -1,6 +1,9 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at cd4ede2); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"Fast recordings: filter, then resample" (26-914x);
+# BENCHMARKS.md summary row.
 """Filter-then-resample against interpolate-then-filter for a fast recording with inverter ripple (issue 10).
 
-    python benchmarks/bench_resample.py [--rate 64000]
+    python studies/bench_resample.py [--rate 64000]
 
 A current recorded at --rate: a 3 Hz + 40 Hz signal (what the comparison keeps) plus 50 mA of
 hysteresis-inverter ripple whose switching frequency wanders 12-20 kHz (16 kHz ± 4 kHz at 7 Hz),

@@ -1,6 +1,9 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at ceb9152); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"Fault signatures of the HF twin"; docs/theory/hf-model.md
+# §6, §10.
 """What each fault does to the HF current: the figures quoted in docs/theory/hf-model.md §6 and §10.
 
-    python benchmarks/fault_signatures.py
+    python studies/fault_signatures.py
 
 Part 1, the FDI chirp, noise off: change of the filtered i_q (2nd-order Butterworth, 150 Hz,
 zero phase) in % of the healthy RMS; the chaotic floor (friction changed by 1e-5) and the noise
@@ -10,6 +13,8 @@ component turns when φ_e turns by 90° (k7 0 → 0.25).
 """
 
 from __future__ import annotations
+
+import argparse
 
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
@@ -38,7 +43,8 @@ def harmonic(r: emaphm.SimResult, order: int) -> tuple[float, float]:
     return float(np.hypot(c[2], c[3])), float(np.degrees(np.arctan2(c[3], c[2])))
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)  # --help only
     healthy = sosfiltfilt(SOS, emaphm.simulate(emaphm.HEALTHY, noise=False).i_q)
     print("Part 1: FDI chirp, filtered i_q change in % of healthy RMS (noise off)")
     cases = {

@@ -1,10 +1,13 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at 45be1cf); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"How small a torque error ...", §"The switching last stage",
+# results/tail-conditioning-*.txt; docs/theory/monitor-model.md §4-5.
 """How much a small torque error costs each actuator: the conditioning behind the NRMSE tail (issue 8).
 
-    python benchmarks/tail_conditioning.py [--cases 1000] [--case-seed 9002] [--command chirp]
+    python studies/tail_conditioning.py [--cases 1000] [--case-seed 9002] [--command chirp]
                                            [--psi 0.01] [--top 10]
-    python benchmarks/tail_conditioning.py --standstill 300
-    python benchmarks/tail_conditioning.py --step 2e-6
-    python benchmarks/tail_conditioning.py --switching
+    python studies/tail_conditioning.py --standstill 300
+    python studies/tail_conditioning.py --step 2e-6
+    python studies/tail_conditioning.py --switching
 
 The monitor's NRMSE at the true faults has a tail (monitor-model.md §4): a few actuators in a
 thousand reach 5-8 % where the median is under 2 %. This script asks whether those actuators are
@@ -42,10 +45,14 @@ import argparse
 import dataclasses
 import os
 import platform
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # the shared helpers
+from _machine import cpu_model
 from scipy.stats import spearmanr
 
 import emaphm
@@ -53,7 +60,9 @@ from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.commands import Command
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.switching import SWITCHING_STEPS, SwitchingModel
+from emaphm.identification.last_stage import SwitchingModel
+
+SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)  # the paper actuator's (last_stage.switching_steps)
 from emaphm.kernels.transforms import phase_directions
 from emaphm.models import HighFidelityEma, MonitorEma
 from emaphm.params import EmaParams

@@ -1,6 +1,9 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at b75b9c6); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"The whole evaluate() of a generation", results/evaluate-*.txt.
+# The fused path alone is now timed by benchmarks/bench_lf.py --evaluate.
 """One optimiser generation's evaluate() (DESIGN §9): the old path against the fused kernel, 1 vs 2 threads.
 
-    python benchmarks/bench_evaluate.py [--population 96] [--rounds 9] [--seed 0]
+    python studies/bench_evaluate.py [--population 96] [--rounds 9] [--seed 0]
 
 The reference is the HF twin's Table 1 current (noise on, seed 0) on the default FDI chirp (1 s,
 10001 samples); the population is --population random points of the optimiser's box, mapped as
@@ -23,18 +26,22 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numba
 import numpy as np
-from _machine import cpu_model  # benchmarks/ is the script's folder, first on sys.path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # the shared helpers
+from _machine import cpu_model
 
 import emaphm
 from emaphm._versions import versions
 from emaphm.faults import TABLE1_REFERENCE
 from emaphm.identification.fitness import Fitness
-from emaphm.identification.identify import search_to_faults
+from emaphm.identification.problem import search_to_faults
 from emaphm.identification.signals import Comparison
 from emaphm.models import MonitorEma
 

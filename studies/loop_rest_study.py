@@ -1,6 +1,8 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at 52dedda); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"The dead zone's ring"; docs/theory/monitor-model.md.
 """Where the twin's hysteresis loop comes to rest on a locked rotor (issue 8; monitor-model.md §1).
 
-    python benchmarks/loop_rest_study.py [--trials 800] [--seed 2] [--span 0.02]
+    python studies/loop_rest_study.py [--trials 800] [--seed 2] [--span 0.02]
 
 The twin's three hysteresis comparators (`kernels.hf_twin._comparators`, the twin's own) drive a
 star-connected R-L stator with an isolated neutral from the nominal actuator's V_dc, R_s, L_s and

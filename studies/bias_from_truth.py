@@ -1,6 +1,9 @@
+# Study, not a benchmark: moved from benchmarks/ at dae85bf (last changed at ba050eb); rerun it at that
+# commit to reproduce its figures: HISTORY.md §"Multi-fault identification" (30 cases of seed 5151),
+# results/bias-from-truth-5151-2026-11-22.txt; docs/identification.md.
 """Where the identification's own model bias takes the estimate, without the search (issue 8).
 
-    python benchmarks/bias_from_truth.py [--cases 30] [--case-seed 5151] [--seed 1]
+    python studies/bias_from_truth.py [--cases 30] [--case-seed 5151] [--seed 1]
                                          [--corners off,auto,4.6] [--command chirp]
 
 For each random actuator (DESIGN §7 ranges, `emaphm.faults.random_faults` of --case-seed) one
@@ -19,16 +22,23 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import sys
+from pathlib import Path
 
 import numpy as np
-from bench_multifault import noise_seed_of  # benchmarks/ is the script's folder, first on sys.path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # the shared helpers
+from _cases import noise_seed_of
 
 import emaphm
 from emaphm.calibration.scenarios import CALIBRATION_COMMANDS
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
-from emaphm.identification.identify import FaultIdentifier, parse_error_corner, search_to_faults
-from emaphm.identification.optimizers import OptimizerRun, polish
+from emaphm.identification.identifier import FaultIdentifier
+from emaphm.identification.optimizers import OptimizerRun
+from emaphm.identification.polish import polish
+from emaphm.identification.problem import search_to_faults
+from emaphm.identification.settings import parse_error_corner
 from emaphm.models import HighFidelityEma, MonitorEma
 
 
@@ -59,7 +69,7 @@ def main() -> None:
         x0[6] = (k[6] + 0.5) / 2.0  # the representative of k7 inside the box (`recentre_phase`)
         line = []
         for c in corners:
-            ident = FaultIdentifier(monitor=monitor, error_corner_hz=corner_of(c)).prepare(
+            ident = FaultIdentifier(monitor=monitor, error_corner=corner_of(c)).prepare(
                 trace.t, trace.i_q, SampledCommand(trace.t - trace.t[0], trace.theta_cmd), trace.theta_u
             )
 
