@@ -103,8 +103,9 @@ def test_entry_point_is_installed():
     assert exe.is_file(), f"the console script is not installed beside {sys.executable}"
     res = subprocess.run([str(exe), "--version"], capture_output=True, text=True)
     assert res.returncode == 0 and res.stdout.startswith("emaphm ")
-    res = subprocess.run([sys.executable, "-m", "emaphm", "--version"], capture_output=True, text=True)
-    assert res.returncode == 0 and res.stdout.startswith("emaphm ")
+    for module in ("emaphm", "emaphm.cli"):
+        res = subprocess.run([sys.executable, "-m", module, "--version"], capture_output=True, text=True)
+        assert res.returncode == 0 and res.stdout.startswith("emaphm ")
 
 
 def test_the_choice_lists_are_the_codes_own():
