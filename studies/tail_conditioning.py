@@ -61,11 +61,11 @@ from emaphm.commands import Command
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.last_stage import SwitchingModel
-
-SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)  # the paper actuator's (last_stage.switching_steps)
 from emaphm.kernels.transforms import phase_directions
 from emaphm.models import HighFidelityEma, MonitorEma
 from emaphm.params import EmaParams
+
+SWITCHING_STEPS = (2e-6, 2.5e-6, 1.25e-6)  # the paper actuator's (last_stage.switching_steps)
 
 
 def _stats(v: np.ndarray) -> str:

@@ -96,6 +96,25 @@ def test_a_recording_the_model_cannot_explain_reports_no_fault(measured, tmp_pat
     assert '<td class="present">' not in page.read_text()  # no fault marked present
 
 
+def test_input_provenance_names_the_file_and_its_hash_or_the_twin(tmp_path):
+    import json
+
+    import numpy as np
+
+    from emaphm.report import input_provenance
+
+    twin = input_provenance(None, truth=np.array([0.3, 0, 0, 0, 0, 0, 0, 0.5]))
+    assert twin == {"reference": "HF twin, noise on", "sha256": None, "true_faults": [0.3, 0, 0, 0, 0, 0, 0, 0.5],
+                    "channel_map": None, "conversion": None, "params": "nominal", "calibration": "packaged"}  # fmt: skip
+    (tmp_path / "rec.csv").write_text("t,i_a\n")
+    rig = input_provenance(tmp_path / "rec.csv", channel_map=tmp_path / "rig.toml", conversion={"f_s": 1e4},
+                           params=tmp_path / "a.toml", calibration=tmp_path / "c.json")  # fmt: skip
+    assert rig["sha256"] == emaphm.io.sha256_of(tmp_path / "rec.csv") and rig["true_faults"] is None
+    assert rig["channel_map"] == str(tmp_path / "rig.toml") and rig["conversion"] == {"f_s": 1e4}
+    assert (rig["params"], rig["calibration"]) == (str(tmp_path / "a.toml"), str(tmp_path / "c.json"))
+    json.dumps(rig)  # JSON-ready, as write_report shows it
+
+
 def test_cli_report_and_a_bad_report_path(measured, tmp_path, capsys):
     path = tmp_path / "ref.h5"
     emaphm.write_trace(measured, path)

@@ -26,8 +26,8 @@ from .actuator import resolve_params
 from .calibration import Calibration
 from .errors import InputError
 from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
-from .identification.detection import detect
 from .identification.api import identify
+from .identification.detection import detect
 from .identification.metrics import percent_error
 from .identification.optimizers import check_optimizer
 from .models import MonitorEma, check_seed, simulate
@@ -63,15 +63,7 @@ def run_demo(
     """
     console = console or Console()
     output_dir = Path(output_dir)
-    if output_dir.exists() and not output_dir.is_dir():
-        raise InputError(f"--output-dir {output_dir} exists and is not a folder")
-    existing = next(p for p in (output_dir, *output_dir.absolute().parents) if p.exists())
-    if not os.access(existing, os.W_OK | os.X_OK):
-        raise InputError(f"--output-dir {output_dir}: {existing} is not writable")
-    if runs < 1:
-        raise InputError(f"runs must be >= 1, got {runs}")
-    check_optimizer(optimizer)
-    check_seed(seed)
+    _check_inputs(output_dir, runs=runs, optimizer=optimizer, seed=seed)
     actuator = resolve_params(params)
     monitor_model = MonitorEma(
         actuator, calibration=calibration, monitor=monitor
@@ -98,10 +90,39 @@ def run_demo(
                 )
             )
     errors = [percent_error(r.estimate, truth) for r in results]
+    console.print(_table(truth, results, errors, title=f"The paper's Table 1 experiment on the HF twin "
+                                                       f"({optimizer.upper()}, noise seed {seed})"))  # fmt: skip
+    mean, sd = float(np.mean(errors)), float(np.std(errors, ddof=1)) if runs > 1 else 0.0
+    times = [r.wall_time_s for r in results]
+    _print_summary(console, truth, results, mean=mean, sd=sd)
+    figures = _write_figures(output_dir, monitor_model, truth, results, measured=measured, healthy=healthy)
+    console.print("figures: " + ", ".join(str(f) for f in figures))
+    return {
+        "percent_error": errors,
+        "mean": mean,
+        "sd": sd,
+        "wall_time_s": times,
+        "estimates": [r.estimate.tolist() for r in results],
+        "figures": [str(f) for f in figures],
+    }
 
-    table = Table(
-        title=f"The paper's Table 1 experiment on the HF twin ({optimizer.upper()}, noise seed {seed})"
-    )
+
+def _check_inputs(output_dir: Path, *, runs: int, optimizer: str, seed: int) -> None:
+    """Refuse, before the work, an output folder that cannot be written and bad run settings."""
+    if output_dir.exists() and not output_dir.is_dir():
+        raise InputError(f"--output-dir {output_dir} exists and is not a folder")
+    existing = next(p for p in (output_dir, *output_dir.absolute().parents) if p.exists())
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"--output-dir {output_dir}: {existing} is not writable")
+    if runs < 1:
+        raise InputError(f"runs must be >= 1, got {runs}")
+    check_optimizer(optimizer)
+    check_seed(seed)
+
+
+def _table(truth: np.ndarray, results: list[Any], errors: list[float], *, title: str) -> Table:
+    """Table 1: the reference faults, then each run's estimate, %err and wall time."""
+    table = Table(title=title)
     table.add_column("")
     for i in range(len(FAULT_NAMES)):
         table.add_column(f"k{i + 1}", justify="right")
@@ -110,12 +131,17 @@ def run_demo(
     table.add_row("Ref.", *(f"{v:.4g}" for v in truth), "", "")
     for j, (r, e) in enumerate(zip(results, errors, strict=True), start=1):
         table.add_row(str(j), *(f"{v:.4f}" for v in r.estimate), f"{e:.2f}", f"{r.wall_time_s:.1f}")
-    console.print(table)
-    mean, sd = float(np.mean(errors)), float(np.std(errors, ddof=1)) if runs > 1 else 0.0
+    return table
+
+
+def _print_summary(
+    console: Console, truth: np.ndarray, results: list[Any], *, mean: float, sd: float
+) -> None:
+    """%err against the paper's, the wall times, what was detected, the best run's diagnosis."""
     times = [r.wall_time_s for r in results]
     paper = np.array(PAPER_TABLE1_PERCENT_ERR)
     console.print(
-        f"%err {mean:.2f} ± {sd:.2f} (mean ± sd over {runs} runs); the paper: {paper.mean():.2f} ± "
+        f"%err {mean:.2f} ± {sd:.2f} (mean ± sd over {len(results)} runs); the paper: {paper.mean():.2f} ± "
         f'{paper.std(ddof=1):.2f} in "minutes" per run. Wall time per run {np.mean(times):.1f} s '
         f"(min {min(times):.1f}, max {max(times):.1f})."
     )
@@ -129,7 +155,14 @@ def run_demo(
         shown = {**best.to_json(), "truth": truth.tolist()}  # the demo knows the truth of its measurement
         console.print(fault_table(shown, f"Diagnosis of the best-fitting run (seed {best_at + 1})"))
 
+
+def _write_figures(
+    output_dir: Path, monitor_model: MonitorEma, truth: np.ndarray, results: list[Any], *, measured: Any,
+    healthy: Any,
+) -> list[Path]:  # fmt: skip
+    """The HF response, the best run's fit, every run's convergence, the estimates vs the truth."""
     output_dir.mkdir(parents=True, exist_ok=True)
+    best = results[int(np.argmin([r.fitness for r in results]))]
     lf = monitor_model.simulate(best.estimate)
     bounds = {
         f"seed {j}": (r.uncertainty.ci90_low, r.uncertainty.ci90_high)
@@ -141,7 +174,7 @@ def run_demo(
         for j, r in enumerate(results, start=1)
         if r.uncertainty is not None and "phase_undefined" in r.uncertainty.flags[6]
     }
-    figures = [
+    return [
         plot_response({"healthy": healthy, "Table 1 faults": measured}, output_dir / "hf_table1.png",
                       "High-fidelity EMA twin, FDI chirp (noise on)"),
         plot_fit(measured.t, measured.i_q, lf.i_q, output_dir / "identified_current.png"),
@@ -150,12 +183,3 @@ def run_demo(
         plot_vectors(truth, {f"seed {j}": r.estimate for j, r in enumerate(results, start=1)}, FAULT_NAMES,
                      output_dir / "identified_vs_true.png", intervals=bounds, phase_undefined=undefined),
     ]  # fmt: skip
-    console.print("figures: " + ", ".join(str(f) for f in figures))
-    return {
-        "percent_error": errors,
-        "mean": mean,
-        "sd": sd,
-        "wall_time_s": times,
-        "estimates": [r.estimate.tolist() for r in results],
-        "figures": [str(f) for f in figures],
-    }

@@ -1,31 +1,46 @@
-"""Figures (matplotlib, Agg backend): the HF response, the LF calibration (like the paper's Fig. 4), fits, convergence, fault vectors."""
+"""Figures (matplotlib, Agg backend): the HF response, the LF calibration (like the paper's Fig. 4), fits, convergence, fault vectors.
+
+Each figure is a `matplotlib.figure.Figure` drawn by its own Agg canvas and written to a file: no
+pyplot, so the process's backend (an interactive user's, a notebook's) and pyplot's list of open
+figures are left alone.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from .identification.signals import lowpass
 from .results import SimResult
 
-__all__ = ["plot_calibration", "plot_response"]
+__all__ = [
+    "plot_calibration",
+    "plot_convergence",
+    "plot_fit",
+    "plot_fit_curves",
+    "plot_response",
+    "plot_rul",
+    "plot_vectors",
+]
 
 
-def _pyplot():  # type: ignore[no-untyped-def]
-    import matplotlib
+def _figure(figsize: tuple[float, float]) -> Any:
+    """A new figure (constrained layout) drawn by an Agg canvas of its own, outside pyplot."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def plot_response(runs: Mapping[str, SimResult], path: Path, title: str) -> Path:
     """Command and user position, phase currents (of the last run), i_q of every run (Fig. 4a)."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True, layout="constrained")
+    fig = _figure((9, 8))
+    ax = fig.subplots(3, 1, sharex=True)
     last = list(runs.values())[-1]
     ax[0].plot(last.t, last.theta_cmd, "k--", lw=1, label=r"$\theta_{cmd}$")
     for label, r in runs.items():
@@ -43,7 +58,6 @@ def plot_response(runs: Mapping[str, SimResult], path: Path, title: str) -> Path
         a.grid(alpha=0.3)
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -51,8 +65,8 @@ def plot_calibration(
     cases: Mapping[str, tuple[SimResult, SimResult, SimResult]], path: Path, f_s: float = 1e4
 ) -> Path:
     """HF i_q vs LF current before and after calibration (filtered), one row per case (Fig. 4b)."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(len(cases), 1, figsize=(9, 3.2 * len(cases)), sharex=True, layout="constrained")
+    fig = _figure((9, 3.2 * len(cases)))
+    ax = fig.subplots(len(cases), 1, sharex=True)
     for a, (name, (hf, before, after)) in zip(np.atleast_1d(ax), cases.items(), strict=True):
         ref = lowpass(hf.i_q, f_s)
         for label, r, style in (("LF before calibration", before, ":"), ("LF calibrated", after, "-")):
@@ -66,7 +80,6 @@ def plot_calibration(
         a.grid(alpha=0.3)
     np.atleast_1d(ax)[-1].set_xlabel("time [s]")
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -89,9 +102,9 @@ def plot_fit_curves(
     `model`'s current at the estimate (the LF model's, or the switching model's after the last
     stage) and their residual; samples the fitness left out (a rest in a hold, motion faster than
     the monitor was fitted on) shaded, and the unfiltered measurement `raw` behind when given."""
-    plt = _pyplot()
     t, m, f = curves["t"], curves["measured"], curves["fitted"]
-    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True, height_ratios=[3, 1], layout="constrained")
+    fig = _figure((9, 6))
+    ax = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
     if raw is not None:
         ax[0].plot(t, raw, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
     ax[0].plot(t, m, "k", lw=1.0, label="measured $i_q$, filtered")
@@ -110,14 +123,13 @@ def plot_fit_curves(
     if title:
         fig.suptitle(title, fontsize=10)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
 def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
     """Best fitness per generation of each run (log scale)."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+    fig = _figure((7, 4))
+    ax = fig.subplots()
     for label, h in histories.items():
         ax.semilogy(np.arange(1, len(h) + 1), h, lw=1.2, label=label)
     ax.set_xlabel("generation (global search, then polish)")
@@ -125,7 +137,6 @@ def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -143,8 +154,8 @@ def plot_vectors(
     bar (k7 only when its arc does not wrap through 0). The k7 bar of each label in
     `phase_undefined` is greyed out: its eccentricity is too small for its direction to mean anything.
     """
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(9, 4), layout="constrained")
+    fig = _figure((9, 4))
+    ax = fig.subplots()
     first = 0 if truth is None else 1
     n = len(estimates) + first
     width = 0.8 / n
@@ -171,7 +182,6 @@ def plot_vectors(
     ax.legend(fontsize=7, ncols=3)
     ax.grid(alpha=0.3, axis="y")
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -179,11 +189,11 @@ def plot_rul(report: dict, path: Path) -> Path:
     """An actuator's prognosis (`prognostics.rul_report`): per tracked fault its measurements with
     90 % whiskers, the fitted law with its band up to the crossing, the threshold and the RUL's
     5-95 % range; below, the distribution of the flights to the first failure."""
-    plt = _pyplot()
     trends = report["_trends"]
     estimates = report["_estimates"]
     n = len(trends)
-    fig, axes = plt.subplots(n + 1, 1, figsize=(9, 2.6 * (n + 1)), layout="constrained", squeeze=False)
+    fig = _figure((9, 2.6 * (n + 1)))
+    axes = fig.subplots(n + 1, 1, squeeze=False)
     t_now = report["at_flight"]
     for ax, (name, trend) in zip(axes[:-1, 0], trends.items(), strict=False):
         f = report["faults"][name]
@@ -217,5 +227,4 @@ def plot_rul(report: dict, path: Path) -> Path:
     ax.set_xlabel("flights")
     fig.suptitle(f"actuator {report['actuator']} ({report['campaign']})", fontsize=10)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path

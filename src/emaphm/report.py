@@ -17,12 +17,13 @@ import html
 import json
 import os
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from .errors import InputError
 
-__all__ = ["REPORT_FILES", "check_report_dir", "write_report"]
+__all__ = ["REPORT_FILES", "check_report_dir", "input_provenance", "write_report"]
 
 REPORT_FILES = ("fit.png", "faults.png", "convergence.png", "index.html")
 
@@ -83,6 +84,35 @@ def write_report(
         page.write_text(_page(data, figures, provenance or {}), encoding="utf-8")
         os.replace(page, out / "index.html")
     return out / "index.html"
+
+
+def input_provenance(
+    reference: str | os.PathLike[str] | None,
+    *,
+    truth: Sequence[float] | None = None,
+    channel_map: str | os.PathLike[str] | None = None,
+    conversion: dict[str, Any] | None = None,
+    params: str | os.PathLike[str] | None = None,
+    calibration: str | os.PathLike[str] | None = None,
+) -> dict[str, Any]:
+    """The report's description of an identification's input, for `write_report(provenance=)`.
+
+    `reference` is the file identified (its SHA-256 is recorded), or None for the HF twin run
+    with `truth`; `channel_map` and `conversion` (``settings["conversion"]`` of the result) when
+    the file was a rig's recording; `params` and `calibration` the files given (None: the nominal
+    actuator, the packaged calibration).
+    """
+    from .io import sha256_of
+
+    return {
+        "reference": str(reference) if reference is not None else "HF twin, noise on",
+        "sha256": sha256_of(reference) if reference is not None else None,
+        "true_faults": None if truth is None else [float(v) for v in truth],
+        "channel_map": str(channel_map) if channel_map is not None else None,
+        "conversion": conversion,
+        "params": str(params) if params is not None else "nominal",
+        "calibration": str(calibration) if calibration is not None else "packaged",
+    }
 
 
 _STYLE = """

@@ -37,10 +37,10 @@ from ..actuator import resolve_params
 from ..choices import OPTIMIZERS
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY
-from ..identification.detection import DETECTABLE, detect
 from ..identification.api import identify
-from ..identification.weights import resolve_error_corner
+from ..identification.detection import DETECTABLE, detect
 from ..identification.last_stage import resolve_last_stage
+from ..identification.weights import resolve_error_corner
 from ..io import atomic_path, check_output_path
 from ..models import MonitorEma, check_seed
 from ..params import EmaParams

@@ -1,0 +1,116 @@
+"""`emaphm calibrate` (the monitor's coefficients) and `emaphm calibrate-uq` (the intervals' factors)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .._threads import numba_threads
+from ..errors import InputError
+from .options import (
+    CalibrationOption,
+    MonitorOption,
+    ParamsNeedCalibrationOption,
+    ParamsOption,
+    WorkersOption,
+)
+from .output import err, progress
+
+__all__ = ["calibrate", "calibrate_uq"]
+
+
+def calibrate(
+    output: Annotated[Path, typer.Option("--output", "-o", help="Calibration file to write (JSON).")] = Path(
+        "lf-calibration.json"
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the GA and of the noisy check.")] = 1,
+    pop_size: Annotated[int, typer.Option(help="GA population size.")] = 60,
+    generations: Annotated[int, typer.Option(help="GA generations.")] = 150,
+    workers: WorkersOption = 0,
+    monitor: Annotated[
+        str, typer.Option(help="Monitor model to calibrate: 'default', or 'paper' (eqs. 1-2 alone).")
+    ] = "default",
+    params: ParamsOption = None,
+    free: Annotated[
+        str | None,
+        typer.Option(
+            help="Fit only these coefficients (comma-separated, e.g. 'i_D'); the others are held at --start's."
+        ),
+    ] = None,
+    start: Annotated[
+        Path | None,
+        typer.Option(
+            help="Calibration whose coefficients --free leaves as they are (default: the packaged one)."
+        ),
+    ] = None,
+) -> None:
+    """Re-run the LF calibration against the HF twin (of the actuator file) and write the calibration file."""
+    from ..actuator import resolve_params
+    from ..calibration import load_calibration
+    from ..calibration.fit_monitor import calibrate as run_calibration
+    from ..io import check_output_path
+    from ..models import check_seed
+
+    check_seed(seed)
+    check_output_path(output, suffixes=(".json",), inputs=(params, start))
+    if start is not None and free is None:
+        raise InputError("--start needs --free: it names the coefficients the others are held for")
+    names = None if free is None else [n.strip() for n in free.split(",") if n.strip()]
+    actuator = resolve_params(params)
+    held = None if start is None else load_calibration(start)
+    with numba_threads(workers, name="--workers"), progress() as update:
+        cal = run_calibration(
+            monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update,
+            params=actuator, free=names, start=held,
+        )  # fmt: skip
+    cal.save(output)
+    for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
+        values = [s["nrmse"] for s in cal.record[key]]
+        err.print(
+            f"{title}: NRMSE {100 * min(values):.1f} to {100 * max(values):.1f} % over {len(values)} scenarios"
+        )
+    err.print(
+        f"wrote {output} (seed {seed}, actuator {cal.params_hash}, {cal.record['settings']['wall_time_s']:.0f} s)"
+    )
+
+
+def calibrate_uq(
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Interval calibration file to write (JSON).")
+    ] = Path("uq-calibration.json"),
+    cases: Annotated[int, typer.Option(help="Random HF actuators to identify (about 5 s each).")] = 160,
+    seed: Annotated[int, typer.Option(help="Seed of the cases, their noise and the optimiser.")] = 4101,
+    calibration: CalibrationOption = None,
+    monitor: MonitorOption = None,
+    workers: WorkersOption = 0,
+    params: ParamsNeedCalibrationOption = None,
+) -> None:
+    """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
+    from ..actuator import resolve_params
+    from ..calibration.fit_intervals import calibrate_uq as run_calibrate_uq
+    from ..io import check_output_path
+    from ..models import MonitorEma, check_seed
+
+    check_seed(seed)
+    if cases < 20:
+        raise InputError(f"--cases must be >= 20 (coverage needs a sample), got {cases}")
+    check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
+    actuator = resolve_params(params)
+    MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
+    with numba_threads(workers, name="--workers"), progress() as update:
+
+        def report(stage: str, done: int, total: int) -> None:
+            update(stage, done, total)
+            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
+                err.print(f"{done}/{total} {stage}")
+
+        factors = run_calibrate_uq(
+            cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
+            params=actuator,
+        )  # fmt: skip
+    factors.save(output)
+    for name, fit in factors.record["training"].items():
+        err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
+    err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")

@@ -1,0 +1,83 @@
+"""`emaphm campaign run` and `emaphm campaign status`: fleet campaigns (docs/campaigns.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import InputError
+from .output import campaign_progress, err
+from .render import print_campaign_status
+
+__all__ = ["campaign_app", "campaign_run", "campaign_status_command"]
+
+
+campaign_app = typer.Typer(
+    help="Fleet campaigns: many identifications from one file, on Dask, into a results store (docs/campaigns.md).",
+    no_args_is_help=True,
+)
+
+
+@campaign_app.command("run")
+def campaign_run(
+    spec: Annotated[Path, typer.Argument(help="Campaign file (TOML).")],
+    out: Annotated[Path, typer.Option("--out", help="Folder of the results store (created if missing).")],
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            help="Dask scheduler address (default: DASK_SCHEDULER_ADDRESS, else a local cluster); 'serial': no Dask."
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(help="Local worker processes, one numba thread each (default: one per core)."),
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Print the summary as one JSON object.")] = False,
+) -> None:
+    """Run the jobs of a campaign that the store does not hold yet (a rerun completes an interrupted one).
+
+    Exit status 0 when every job is done, 1 when some failed (recorded in the store's failures;
+    a rerun tries them again).
+    """
+    import json
+
+    from ..campaign import load_campaign, run_campaign
+
+    campaign = load_campaign(spec)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: exists and is not a folder")
+    if not out.absolute().parent.is_dir():
+        raise InputError(f"--out {out}: folder {out.absolute().parent} does not exist")
+    with campaign_progress(campaign.name) as update:
+        summary = run_campaign(campaign, out, scheduler=scheduler, workers=workers, progress=update)
+    data = summary.to_json()
+    if json_out:
+        typer.echo(json.dumps(data))
+    err.print(
+        f"campaign {summary.campaign}: {summary.jobs} jobs, {summary.already_done} already done, "
+        f"{summary.done} done now, {summary.failed} failed ({summary.backend}, {summary.wall_time_s:.1f} s); "
+        f"store {out}"
+    )
+    if summary.failed:
+        err.print(f"emaphm: {summary.failed} job(s) failed: see 'emaphm campaign status {spec} {out}'")
+        raise typer.Exit(1)
+
+
+@campaign_app.command("status")
+def campaign_status_command(
+    spec: Annotated[Path, typer.Argument(help="Campaign file (TOML).")],
+    out: Annotated[Path, typer.Argument(help="Folder of the results store.")],
+    json_out: Annotated[bool, typer.Option("--json", help="Print the counts as one JSON object.")] = False,
+) -> None:
+    """Count the done, failed and missing jobs of a campaign in a results store."""
+    import json
+
+    from ..campaign import campaign_status
+
+    data = campaign_status(spec, out)
+    if json_out:
+        typer.echo(json.dumps(data))
+        return
+    print_campaign_status(data)

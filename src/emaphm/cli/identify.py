@@ -1,0 +1,152 @@
+"""`emaphm identify`: the fault vector from a recording, a trace or the HF twin, printed or as JSON.
+
+The inputs' options are declared here, one type each; the settings' options are made from
+`IdentifySettings` (`options.with_settings_options`), the one list of them. The command checks every input before the work
+(`_checked_inputs`: exit 2 and nothing written), runs `emaphm.identify`, then
+writes what was asked for: the JSON file, the report folder, the table or one JSON object.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from ..errors import InputError
+from ..identification.settings import IdentifySettings
+from .options import CalibrationOption, ParamsNeedCalibrationOption, with_settings_options
+from .output import err, progress
+from .render import print_identification
+
+__all__ = ["identify"]
+
+TrueFaultsOption = Annotated[
+    str | None,
+    typer.Option(help="Simulate the HF twin (noise on) with these faults k1..k8 and identify them."),
+]
+ReferenceOption = Annotated[
+    Path | None,
+    typer.Option(
+        help="Identify from a trace ('emaphm simulate', 'emaphm convert'), or a recording with --map."
+    ),
+]
+MapOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--map",
+        help="Channel map (TOML) that reads --reference as a rig's recording (docs/your-actuator.md).",
+    ),
+]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON object to stdout.")]
+OutputOption = Annotated[Path | None, typer.Option("--output", "-o", help="Also write the JSON result here.")]
+UqCalibrationOption = Annotated[
+    Path | None,
+    typer.Option(help="Interval calibration from 'emaphm calibrate-uq' (default: the packaged one)."),
+]
+ReportOption = Annotated[
+    Path | None,
+    typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
+]
+
+
+def identify(
+    true_faults: TrueFaultsOption = None,
+    reference: ReferenceOption = None,
+    map_file: MapOption = None,
+    json_out: JsonOption = False,
+    output: OutputOption = None,
+    calibration: CalibrationOption = None,
+    uq_calibration: UqCalibrationOption = None,
+    params: ParamsNeedCalibrationOption = None,
+    report: ReportOption = None,
+    **options: Any,
+) -> None:
+    """Identify the fault vector from a measured (or simulated) quadrature current.
+
+    Exit status 0 with a diagnosis, 2 for bad input (nothing run), 3 when the monitor cannot
+    explain the recording (verdict "does not fit": no faults are reported).
+    """
+    import json
+
+    from ..identification.api import identify as run_identify
+    from ..io import atomic_path
+
+    settings = IdentifySettings.from_mapping(options, where="identify")
+    truth = _checked_inputs(
+        true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
+        uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
+    )  # fmt: skip
+    with progress() as update:
+        result = run_identify(
+            truth, reference, settings=settings, calibration=calibration, uq_calibration=uq_calibration,
+            params=params, channel_map=map_file,
+            on_generation=lambda gen, total, best: update(
+                "MCMC steps" if gen < 0 else f"{settings.optimizer.upper()} generations", abs(gen), total
+            ),
+        )  # fmt: skip
+    data = result.to_json()
+    for warning in data["warnings"]:
+        err.print(f"emaphm: warning: {warning}", soft_wrap=True)
+    if output is not None:
+        with atomic_path(output) as tmp:
+            tmp.write_text(json.dumps(data, indent=2) + "\n")
+    if report is not None:
+        from ..report import input_provenance, write_report
+
+        provenance = input_provenance(
+            reference, truth=truth, channel_map=map_file, conversion=data["settings"].get("conversion"),
+            params=params, calibration=calibration,
+        )  # fmt: skip
+        page = write_report(result, report, provenance=provenance)
+        err.print(f"wrote the report {page}")
+    if json_out:
+        typer.echo(json.dumps(data))
+    else:
+        print_identification(data)
+    if data["verdict"] != "fits":
+        raise typer.Exit(3)  # ran, but no diagnosis: scripts must not read it as one
+
+
+# the settings' options (`IdentifySettings`, the one list of them) after the inputs, in its order
+with_settings_options(identify)
+
+
+def _checked_inputs(
+    *, true_faults: str | None, reference: Path | None, map_file: Path | None, uncertainty: str,
+    uq_calibration: Path | None, output: Path | None, report: Path | None, calibration: Path | None,
+    params: Path | None,
+) -> Any:  # fmt: skip
+    """Every check of `identify`'s inputs and files, before the work (the settings are checked
+    when made, first): the truth or None. The input files, the output paths (none may be one of the
+    files read) and the interval calibration.
+    """
+    from ..faults import parse_faults
+    from ..io import check_output_path, check_trace_path
+
+    if (true_faults is None) == (reference is None):
+        raise InputError("give exactly one of --true-faults or --reference")
+    truth = parse_faults(true_faults, option="--true-faults") if true_faults is not None else None
+    if reference is not None and map_file is None:
+        check_trace_path(reference, for_writing=False)
+    if map_file is not None:
+        from ..measured import ChannelMap
+
+        if reference is None:
+            raise InputError("--map reads a recording: give it with --reference")
+        ChannelMap.load(map_file)  # a bad map: refused before the work
+    if output is not None:
+        check_output_path(
+            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params, map_file)
+        )
+    if report is not None:
+        from ..report import check_report_dir
+
+        check_report_dir(report)
+    if uncertainty == "none" and uq_calibration is not None:
+        raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
+    if uncertainty != "none":
+        from ..identification.uncertainty import load_factors
+
+        load_factors(uq_calibration)  # a bad file: refused before the work
+    return truth

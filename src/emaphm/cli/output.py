@@ -1,0 +1,85 @@
+"""Where the command line writes: stderr for messages and progress, stdout for results.
+
+Messages, warnings and progress go to `err` (stderr), so that stdout carries only the result (a
+table, or one JSON object with ``--json``). Bars and spinners show on an interactive terminal only;
+CI logs get a line now and then, or nothing.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager, nullcontext
+from typing import Any
+
+from rich.console import Console
+
+__all__ = ["campaign_progress", "err", "progress", "status", "stdout_console"]
+
+err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
+
+
+def status(message: str) -> Any:
+    """A spinner on an interactive terminal, nothing otherwise (CI logs stay clean)."""
+    return err.status(message) if err.is_terminal else nullcontext()
+
+
+def stdout_console() -> Console:
+    """Console for results on stdout; 120 columns when not a terminal, so logs get whole tables."""
+    return Console(highlight=False, width=None if sys.stdout.isatty() else 120)
+
+
+@contextmanager
+def progress() -> Iterator[Callable[[str, int, int], None]]:
+    """A progress bar on an interactive terminal (one task per stage); a no-op otherwise."""
+    if not err.is_terminal:
+        yield lambda stage, done, total: None
+        return
+    from rich.progress import Progress
+
+    from ..identification.cmaes import import_cmaes
+
+    import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
+
+    with Progress(console=err, transient=True) as bar:
+        tasks: dict[str, Any] = {}
+
+        def update(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(stage, total=total)
+            bar.update(tasks[stage], completed=done)
+
+        yield update
+
+
+@contextmanager
+def campaign_progress(name: str) -> Iterator[Callable[[int, int, int, float], None]]:
+    """A bar with done / failed / remaining and the rate on a terminal; a line every 10 % in logs."""
+    if not err.is_terminal:
+        marks: set[int] = set()
+
+        def log(done: int, failed: int, total: int, elapsed: float) -> None:
+            tenth = (10 * (done + failed)) // max(total, 1)
+            if total and tenth not in marks:
+                marks.add(tenth)
+                rate = 3600.0 * (done + failed) / elapsed if elapsed > 0 else 0.0
+                err.print(
+                    f"{name}: {done} done, {failed} failed, {total - done - failed} remaining ({rate:.0f} jobs/h)"
+                )
+
+        yield log
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
+        TimeRemainingColumn(), console=err, transient=True,
+    ) as bar:  # fmt: skip
+        task = bar.add_task(f"campaign {name}", total=None, info="")
+
+        def update(done: int, failed: int, total: int, elapsed: float) -> None:
+            rate = 3600.0 * (done + failed) / elapsed if elapsed > 0 else 0.0
+            info = f"{failed} failed, {total - done - failed} remaining, {rate:.0f} jobs/h"
+            bar.update(task, total=total, completed=done + failed, info=info)
+
+        yield update
