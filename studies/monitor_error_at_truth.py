@@ -42,9 +42,9 @@ from emaphm.calibration.scenarios import CALIBRATION_COMMANDS, FIT_SCENARIOS
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
-from emaphm.identification.fitness import (
+from emaphm.identification.fitness import Fitness
+from emaphm.identification.weights import (
     ERROR_CORNER_HZ,
-    Fitness,
     band_mask,
     command_frequency,
     error_weights,

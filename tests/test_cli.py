@@ -355,7 +355,7 @@ def _write_bad_traces(d):
     [
         (["identify"], "exactly one of"),
         (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--reference", "x.h5"], "exactly one of"),
-        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--optimizer", "sa"], "unknown optimizer"),
+        (["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--optimizer", "sa"], "unknown --optimizer"),
         (["identify", "--true-faults", "0,0,0,0,0,0,0,1.5"], "--true-faults"),
         (["identify", "--reference", "missing.h5"], "no such file"),
         (["identify", "--reference", "corrupt.h5"], "cannot read"),

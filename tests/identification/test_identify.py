@@ -255,7 +255,7 @@ def test_the_fitness_weights_motion_by_the_monitors_error_growing_with_frequency
     np.testing.assert_array_equal(paper.objective_.weights, Fitness(paper.reference_).weights)
     assert resolve_error_corner(2.5, "paper") == 2.5
     for bad in (0.0, -1.0, float("nan"), "fast"):
-        with pytest.raises(InputError, match="error.corner"):
+        with pytest.raises(InputError, match=r"error.corner"):
             resolve_error_corner(bad, "default")
-    with pytest.raises(InputError, match="error.corner"):
+    with pytest.raises(InputError, match=r"error.corner"):
         identify([0] * 7 + [0.5], error_corner=-2.0)

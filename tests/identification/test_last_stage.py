@@ -99,7 +99,7 @@ def test_a_bias_that_changes_with_the_faults_converges_towards_the_truth():
 
 
 def test_a_switching_run_that_diverges_ends_the_stage_with_the_best_iterate_so_far():
-    objective, residuals_of, monitor, switching, x0, truth = _oracle(bias_slope=0.02)
+    objective, residuals_of, monitor, switching, x0, _ = _oracle(bias_slope=0.02)
     calls = []
 
     def flaky(k):
@@ -120,7 +120,7 @@ def test_a_switching_run_that_diverges_ends_the_stage_with_the_best_iterate_so_f
 def test_the_stage_says_why_it_stopped_early():
     # review L2: a monitor that diverges mid-way, and a polish that cannot move, end the iterations
     # with their reason in the record (before: the first was swallowed silently, the second ran on)
-    objective, residuals_of, monitor, switching, x0, truth = _oracle(bias_slope=0.02)
+    objective, residuals_of, monitor, switching, x0, _ = _oracle(bias_slope=0.02)
     calls = []
 
     def flaky_monitor(k):
@@ -182,11 +182,11 @@ def test_the_last_stage_setting():
     assert resolve_last_stage("switching", "paper") == "switching"
     assert resolve_last_stage("none", "default") == "none"
     assert resolve_last_stage("switching", "default", polish=False) == "none"  # a raw search
-    with pytest.raises(InputError, match="last.stage"):
+    with pytest.raises(InputError, match=r"last.stage"):
         resolve_last_stage("fast", "default")
-    with pytest.raises(InputError, match="last.stage"):
+    with pytest.raises(InputError, match=r"last.stage"):
         FaultIdentifier(last_stage="fast")
-    with pytest.raises(InputError, match="last.stage"):
+    with pytest.raises(InputError, match=r"last.stage"):
         identify([0] * 7 + [0.5], last_stage="fast")
 
 

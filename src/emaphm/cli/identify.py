@@ -14,8 +14,12 @@ from typing import Annotated, Any
 import typer
 
 from ..errors import InputError
-from ..identification.settings import IdentifySettings
-from .options import CalibrationOption, ParamsNeedCalibrationOption, with_settings_options
+from .options import (
+    CalibrationOption,
+    ParamsNeedCalibrationOption,
+    settings_from_options,
+    with_settings_options,
+)
 from .output import err, progress
 from .render import print_identification
 
@@ -72,7 +76,7 @@ def identify(
     from ..identification.api import identify as run_identify
     from ..io import atomic_path
 
-    settings = IdentifySettings.from_mapping(options, where="identify")
+    settings = settings_from_options(options)
     truth = _checked_inputs(
         true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,

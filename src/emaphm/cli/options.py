@@ -25,6 +25,7 @@ __all__ = [
     "ParamsNeedCalibrationOption",
     "ParamsOption",
     "WorkersOption",
+    "settings_from_options",
     "with_settings_options",
 ]
 
@@ -75,3 +76,21 @@ def with_settings_options(command: Callable[..., Any]) -> Callable[..., Any]:
     command.__signature__ = signature.replace(parameters=[*inputs, *added])  # type: ignore[attr-defined]
     command.__annotations__ = {**{p.name: p.annotation for p in [*inputs, *added]}, "return": None}
     return command
+
+
+def settings_from_options(options: dict[str, Any]) -> Any:
+    """The `IdentifySettings` of the command line's settings options; a refusal names the option
+    as typed (``unknown --last-stage 'fast'``, ``--error-corner must be ...``)."""
+    from ..errors import InputError
+    from ..identification.settings import IdentifySettings
+
+    try:
+        return IdentifySettings.from_mapping(options, where="identify")
+    except InputError as exc:
+        text = str(exc)
+        for name in options:
+            flag = "--" + name.replace("_", "-")
+            for before in (f"unknown {name} ", f"{name} must "):
+                if text.startswith(before):
+                    raise InputError(text.replace(name, flag, 1)) from None
+        raise
