@@ -43,6 +43,7 @@ from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
 from emaphm.identification import Comparison
 from emaphm.identification.fitness import Fitness
+from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.weights import (
     ERROR_CORNER_HZ,
     band_mask,
@@ -50,7 +51,6 @@ from emaphm.identification.weights import (
     error_weights,
     moving_mask,
 )
-from emaphm.identification.identifier import FaultIdentifier
 from emaphm.models import HighFidelityEma, MonitorEma
 
 
