@@ -2,7 +2,9 @@
 
 import re
 import runpy
+import shlex
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -25,6 +27,10 @@ def test_readme_quick_start_has_two_commands_and_ci_runs_the_test_one():
     assert commands[0].endswith("emaphm demo")
     assert "pytest" in commands[1]
     assert commands[1] in (ROOT / ".ci" / "run").read_text().splitlines()
+    # the whole suite: it selects back the tests marked slow, which the default run leaves out
+    assert shlex.split(commands[1])[-2:] == ["-m", "slow or not slow"]
+    pytest_options = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    assert '-m "not slow"' in pytest_options["addopts"]
 
 
 def test_parameter_table_in_the_docs_is_generated_from_the_code():
