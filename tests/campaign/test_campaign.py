@@ -204,6 +204,7 @@ run_campaign(sys.argv[1], sys.argv[2], workers=1, flush_rows=1)
 """
 
 
+@pytest.mark.slow  # ~4-7 s: four subprocesses, each importing emaphm, killed mid-campaign
 def test_kill_9_at_any_moment_then_rerun_gives_every_job_once(tmp_path):
     spec = write_spec(tmp_path)
     out = tmp_path / "store"
@@ -262,6 +263,7 @@ def test_a_campaign_job_gives_the_estimate_of_a_lone_identification(tmp_path):
         assert [row[f"k{i}"] for i in range(1, 9)] == alone.estimate.tolist()
 
 
+@pytest.mark.slow  # ~3-4 s: a local dask cluster started and stopped
 def test_dask_runs_the_same_jobs_on_one_numba_thread_per_worker(tmp_path):
     pytest.importorskip("distributed")
     spec = write_spec(tmp_path)

@@ -120,6 +120,7 @@ def test_each_monitor_has_its_own_trigger(trace, monkeypatch):
     assert ran["paper"]["ran"] is False and ran["default"]["trigger"] == SECOND_SEARCH_NRMSE["default"]
 
 
+@pytest.mark.slow  # ~8 s: five real searches; the decision itself is checked on canned searches
 def test_the_kept_result_is_the_better_of_the_two_searches_run_alone(trace, monkeypatch):
     # a small search (pop 16 x 3, a tiny polish) fits this actuator to 2.2 % at every seed tried:
     # a trigger at half that must start the second search

@@ -72,6 +72,7 @@ class LinearObjective:
         return self.f(monitor.simulate_many(K))
 
 
+@pytest.mark.slow  # ~10 s: 120 draws of a 1 s trace at 10 kHz
 def test_laplace_intervals_of_a_linear_gaussian_oracle_cover_90_percent():
     """White noise through the comparison's 150 Hz filter, on the real length (1 s at 10 kHz): the
     residual is autocorrelated, and only the autocorrelation-consistent (sandwich) variance comes
