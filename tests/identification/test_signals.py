@@ -136,12 +136,16 @@ def test_lowpass_refuses_a_signal_the_filter_cannot_pad():
 def test_an_identification_imports_neither_scipy_signal_nor_matplotlib_nor_scipy_stats():
     # their imports cost 0.9 s (scipy 1.17 loads all of scipy.signal), 0.35 s and 0.46 s (`cma`
     # imports matplotlib.pyplot and scipy.stats) of every `emaphm identify`; the whole default
-    # path: GA, CMA-ES polish, least squares, Laplace intervals
+    # path: GA, CMA-ES polish, least squares, the switching last stage, Laplace intervals. Each
+    # stage at its smallest budget: what a stage imports does not depend on how long it runs.
     code = (
         "import sys\n"
+        "from emaphm.identification import limits\n"
         "from emaphm.identification.api import identify\n"
+        "limits.POLISH_BUDGET, limits.LS_MAX_NFEV, limits.SWITCHING_ITERATIONS = (8, 2), 3, 1\n"
         "r = identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=2, pop_size=8)\n"
         "assert r.uncertainty is not None and r.stage('least_squares')['ran']\n"
+        "assert r.stage('polish')['ran'] and r.stage('last_stage')['switching'] is not None\n"
         "print([m for m in ('scipy.signal', 'matplotlib', 'scipy.stats') if m in sys.modules])\n"
         "import matplotlib.pyplot, scipy.stats\n"  # and both are importable afterwards
         "print(matplotlib.pyplot.__name__, scipy.stats.norm.cdf(0.0))\n"
