@@ -204,6 +204,7 @@ def two_shorts():
     return k, emaphm.simulate(k, seed=11)
 
 
+@pytest.mark.slow  # ~10 s: the switching model run over the whole trace 8 times (2 to 5 us steps)
 def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, tiny_polish):
     _, trace = two_shorts
     ident = FaultIdentifier(seed=2, **BUDGET).fit(trace.t, trace.i_q, Chirp(), trace.theta_u)
