@@ -116,8 +116,10 @@ def test_a_result_records_its_settings_its_constants_and_each_stage(monkeypatch)
     from emaphm.identification import limits
 
     monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))
+    monkeypatch.setattr(limits, "SWITCHING_ITERATIONS", 1)  # the last stage runs, at its least cost
     res = identify([0.2, 0, 0, 0, 0, 0, 0, 0.5], seed=2, pop_size=8, generations=2, uncertainty="none")
     record = res.settings
+    assert record["limits"]["SWITCHING_ITERATIONS"] == 1 and res.stage("last_stage")["switching"] is not None
     assert (
         record["identify"]
         == IdentifySettings(seed=2, pop_size=8, generations=2, uncertainty="none").to_json()
