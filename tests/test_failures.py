@@ -128,6 +128,7 @@ def test_temporaries_of_a_killed_process_are_removed_by_the_next_write(tmp_path)
     assert not stale.exists() and mine.exists()
 
 
+@pytest.mark.slow  # ~4.5 s: a real identification process, interrupted after 4 s
 def test_ctrl_c_during_identify_exits_130_with_one_line(tmp_path):
     # a real SIGINT to a real process, as a shell's Ctrl-C would send it
     out = tmp_path / "r.json"

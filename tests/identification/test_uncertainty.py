@@ -262,15 +262,18 @@ def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_sa
 
 
 def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):
+    from emaphm.identification import limits
     from emaphm.identification.api import identify
     from emaphm.identification.uncertainty import mcmc
 
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))  # the chain needs a fit, not a converged one
     monkeypatch.setattr(mcmc, "MAX_STEPS", 60)
     monkeypatch.setattr(mcmc, "CHUNK", 30)
     steps = []
+    # the chain on the monitor's eq. 3, without the switching last stage (not what is checked here)
     res = identify(
         [0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, uncertainty="mcmc", on_generation=lambda g, t, b: steps.append(g),
-        pop_size=16, generations=5,
+        pop_size=16, generations=5, last_stage="none",
     )  # fmt: skip
     assert res.fits
     data = res.to_json()
