@@ -1,4 +1,5 @@
-"""`emaphm calibrate` (the monitor's coefficients) and `emaphm calibrate-uq` (the intervals' factors)."""
+"""`emaphm calibrate` (the monitor's coefficients), `emaphm calibrate-uq` (the intervals' factors) and
+`emaphm calibrate-detection` (the detection thresholds)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from .options import (
 )
 from .output import err, progress
 
-__all__ = ["calibrate", "calibrate_uq"]
+__all__ = ["calibrate", "calibrate_detection", "calibrate_uq"]
 
 
 def calibrate(
@@ -114,3 +115,44 @@ def calibrate_uq(
     for name, fit in factors.record["training"].items():
         err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
     err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")
+
+
+def calibrate_detection(
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Detection thresholds file to write (JSON).")
+    ] = Path("detection.json"),
+    runs: Annotated[
+        int, typer.Option(help="Healthy identifications for the thresholds, and as many to count false alarms.")
+    ] = 20,
+    seed: Annotated[int, typer.Option(help="Seed of the first healthy run (the false alarms' start 1000 later).")] = 1000,
+    sensitivity: Annotated[
+        bool, typer.Option("--sensitivity/--no-sensitivity", help="Also check that each single fault of 0.1 is detected.")
+    ] = True,
+    calibration: CalibrationOption = None,
+    monitor: MonitorOption = None,
+    workers: WorkersOption = 0,
+    params: ParamsNeedCalibrationOption = None,
+) -> None:
+    """Measure the detection thresholds on healthy runs of the HF twin (after 'emaphm calibrate')."""
+    from ..calibration.fit_detection import calibrate_detection as run_calibrate_detection
+    from ..io import check_output_path
+
+    check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
+    with progress() as update:
+
+        def report(stage: str, done: int, total: int) -> None:
+            update(stage, done, total)
+            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
+                err.print(f"{done}/{total} {stage}")
+
+        record = run_calibrate_detection(
+            params=params, calibration=calibration, monitor=monitor, runs=runs, threshold_seed=seed,
+            false_alarm_seed=seed + 1000, sensitivity_seed=seed + 2000 if sensitivity else None,
+            workers=workers, on_progress=report, output=output,
+        )  # fmt: skip
+    for name, value in record["thresholds"].items():
+        err.print(f"{name}: threshold {value:g}")
+    err.print(
+        f"false alarms: {record['false_alarm_runs']} of {record['runs']} fresh healthy runs; "
+        f"wrote {output} ({record['wall_time_s']:.0f} s)"
+    )
