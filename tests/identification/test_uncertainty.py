@@ -194,7 +194,8 @@ def test_the_packaged_calibration_belongs_to_the_packaged_monitor():
         train = packaged.record["training"]
         assert all(0.85 <= v["coverage"] <= 0.97 for v in train.values())
         assert packaged.record["last_stage"] == stage  # each made for its own last stage
-    assert load_factors() is load_factors(last_stage="switching")  # the default identification's
+    default, switching = load_factors(), load_factors(last_stage="switching")  # the default identification's
+    assert default.record == switching.record and default.scale is switching.scale  # one file, read once
     # the switching stage's estimates are closer to the truth: its intervals are the narrower
     narrow, wide = (
         load_factors(last_stage="switching").record["training"],
@@ -338,3 +339,13 @@ def test_the_sandwich_convolution_is_fftconvolves_same(n, half):
         ]
     )
     np.testing.assert_allclose(got[:: max(1, n // 7)], direct, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+def test_the_packaged_interval_calibration_cannot_be_poisoned_by_a_caller():
+    # review L8: the cached loader handed every caller the same mutable arrays and record
+    first = load_factors()
+    with pytest.raises(ValueError, match="read-only"):
+        first.scale[0] = 99.0
+    first.record["created"] = "changed"
+    again = load_factors()
+    assert again.record["created"] != "changed" and np.all(again.scale < 99.0)

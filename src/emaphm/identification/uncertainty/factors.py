@@ -7,6 +7,7 @@ cases that no benchmark uses (`fit_factors`, ``emaphm calibrate-uq``) and shippe
 
 from __future__ import annotations
 
+import copy
 import functools
 import json
 import os
@@ -117,7 +118,10 @@ PACKAGED_FACTORS = {"switching": "uq_calibration.json", "none": "uq_calibration_
 @functools.lru_cache(maxsize=2)
 def _packaged(last_stage: str) -> Factors:
     name = PACKAGED_FACTORS[last_stage]
-    return Factors.from_json(read_package_json(name), f"emaphm/data/{name}")
+    factors = Factors.from_json(read_package_json(name), f"emaphm/data/{name}")
+    for array in (factors.scale, factors.floor):
+        array.setflags(write=False)  # shared by every caller (review L8)
+    return factors
 
 
 def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str = "switching") -> Factors:
@@ -126,7 +130,8 @@ def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str 
     if path is None:
         if last_stage not in PACKAGED_FACTORS:
             raise InputError(f"no packaged interval calibration for the last stage {last_stage!r}")
-        return _packaged(last_stage)
+        shared = _packaged(last_stage)  # its arrays read-only; the record each caller's own copy
+        return Factors(shared.scale, shared.floor, copy.deepcopy(shared.record))
     p = Path(path)
     try:
         data = json.loads(p.read_text())
