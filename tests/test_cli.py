@@ -79,10 +79,11 @@ def test_demo_runs_and_writes_its_figures(tmp_path):
     from rich.console import Console
 
     from emaphm.demo import run_demo
+    from emaphm.identification.settings import IdentifySettings
 
     console = Console(record=True, width=160)
     budget = {"pop_size": 16, "generations": 3, "polish": False}  # the table, not convergence
-    data = run_demo(tmp_path / "demo", runs=2, console=console, budget=budget)
+    data = run_demo(tmp_path / "demo", runs=2, console=console, settings=IdentifySettings(**budget))
     for name in ("hf_table1.png", "identified_current.png", "convergence.png", "identified_vs_true.png"):
         assert (tmp_path / "demo" / name).stat().st_size > 10_000
     out = console.export_text()

@@ -34,12 +34,12 @@ from numpy.typing import NDArray
 from .._version import __version__
 from .._versions import versions
 from ..actuator import resolve_params
-from ..choices import OPTIMIZERS
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY
 from ..identification.api import identify
 from ..identification.detection import DETECTABLE, detect
 from ..identification.last_stage import resolve_last_stage
+from ..identification.settings import IdentifySettings
 from ..identification.weights import resolve_error_corner
 from ..io import atomic_path, check_output_path
 from ..models import MonitorEma, check_seed
@@ -68,45 +68,38 @@ def calibrate_detection(
     *,
     params: EmaParams | str | os.PathLike[str] | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
-    monitor: str | None = None,
+    settings: IdentifySettings | None = None,
     runs: int = DETECTION_RUNS,
     threshold_seed: int = THRESHOLD_SEED,
     false_alarm_seed: int = FALSE_ALARM_SEED,
     sensitivity_seed: int | None = SENSITIVITY_SEED,
-    optimizer: str = "ga",
-    pop_size: int | None = None,
-    generations: int | None = None,
-    workers: int | None = None,
     on_progress: Progress | None = None,
     output: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Measure the detection thresholds (about 5 s per identification, 2·`runs` + 14 of them).
 
     `params` is the actuator (`EmaParams` or an actuator file), `calibration` its LF calibration
-    (the packaged one by default, for the nominal actuator only) and `monitor` the monitor model
-    (None: the calibration's). `pop_size`/`generations` set the search's budget (None: identify's
-    defaults for `optimizer`), `workers` its threads. `on_progress(stage, done, total)` is called
-    after each identification. The record (the thresholds file's content) is returned and, with
-    `output`, written there atomically (a ``.json`` file; the package's own is
+    (the packaged one by default, for the nominal actuator only); `settings` how each
+    identification runs (`IdentifySettings`: the monitor, the optimiser, its budget and threads;
+    its seed is replaced by each run's). `runs` healthy runs from `threshold_seed` give the
+    thresholds, as many from `false_alarm_seed` the false alarms, and single faults from
+    `sensitivity_seed` (None: skipped) the sensitivity. `on_progress(stage, done, total)` is
+    called after each identification. The record (the thresholds file's content) is returned and,
+    with `output`, written there atomically (a ``.json`` file; the package's own is
     ``src/emaphm/data/detection.json``). Bad input raises `InputError` before any work.
     """
     start = time.perf_counter()
-    settings = {
-        "optimizer": optimizer, "pop_size": pop_size, "generations": generations, "runs": runs,
-        "threshold_seed": threshold_seed, "false_alarm_seed": false_alarm_seed,
-        "sensitivity_seed": sensitivity_seed, "workers": workers,
-    }  # fmt: skip
-    actuator, lf = _checked(params, calibration, monitor, settings, output)
-    run = functools.partial(
-        identify, optimizer=optimizer, pop_size=pop_size, generations=generations, workers=workers,
-        calibration=calibration, monitor=monitor, params=actuator, thresholds={},
-    )  # fmt: skip
+    s = settings if settings is not None else IdentifySettings()
+    sets = {"runs": runs, "threshold_seed": threshold_seed, "false_alarm_seed": false_alarm_seed,
+            "sensitivity_seed": sensitivity_seed}  # fmt: skip
+    actuator, lf = _checked(params, calibration, s.monitor, sets, output)
+    run = functools.partial(identify, settings=s, calibration=calibration, params=actuator, thresholds={})
     measured = _measure(run, runs, threshold_seed, false_alarm_seed, sensitivity_seed, on_progress)
     record = {
         "thresholds": measured.pop("thresholds"),
         "monitor": lf.monitor,  # identify() warns when another monitor uses these thresholds
         "rule": DETECTION_RULE,
-        "optimizer": optimizer,
+        "optimizer": s.optimizer,
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),  # the eq. 3 weights the runs used
         "threshold_seeds": [threshold_seed, threshold_seed + runs - 1],
         "false_alarm_seeds": [false_alarm_seed, false_alarm_seed + runs - 1],
@@ -122,7 +115,7 @@ def calibrate_detection(
             "created": lf.record.get("created"),
             "params_hash": lf.params_hash,
         },
-        "settings": settings,
+        "settings": {**sets, "identify": s.to_json()},
         "versions": versions(),
     }
     if output is not None:
@@ -177,10 +170,6 @@ def _checked(
         raise InputError(
             f"the false-alarm runs must be fresh: seeds {second}..{second + runs - 1} overlap the "
             f"threshold runs' {first}..{first + runs - 1}"
-        )
-    if settings["optimizer"] not in OPTIMIZERS:
-        raise InputError(
-            f"unknown optimizer {settings['optimizer']!r}; choose one of {', '.join(OPTIMIZERS)}"
         )
     if output is not None:
         check_output_path(output, suffixes=(".json",), option="output")

@@ -135,9 +135,11 @@ def calibrate_detection(
 ) -> None:
     """Measure the detection thresholds on healthy runs of the HF twin (after 'emaphm calibrate')."""
     from ..calibration.fit_detection import calibrate_detection as run_calibrate_detection
+    from ..identification.settings import IdentifySettings
     from ..io import check_output_path
 
     check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
+    settings = IdentifySettings(monitor=monitor, workers=workers)  # the rest as identify's defaults
     with progress() as update:
 
         def report(stage: str, done: int, total: int) -> None:
@@ -146,9 +148,9 @@ def calibrate_detection(
                 err.print(f"{done}/{total} {stage}")
 
         record = run_calibrate_detection(
-            params=params, calibration=calibration, monitor=monitor, runs=runs, threshold_seed=seed,
+            params=params, calibration=calibration, settings=settings, runs=runs, threshold_seed=seed,
             false_alarm_seed=seed + 1000, sensitivity_seed=seed + 2000 if sensitivity else None,
-            workers=workers, on_progress=report, output=output,
+            on_progress=report, output=output,
         )  # fmt: skip
     for name, value in record["thresholds"].items():
         err.print(f"{name}: threshold {value:g}")

@@ -79,8 +79,9 @@ def demo(
 ) -> None:
     """The main job: the paper's Table 1 experiment (HF twin with noise, five identifications)."""
     from ..demo import run_demo
+    from .options import settings_from_options
 
     run_demo(
-        output_dir, seed=seed, optimizer=optimizer, runs=runs, calibration=calibration, monitor=monitor,
-        console=stdout_console(), status=status, params=params,
+        output_dir, seed=seed, runs=runs, settings=settings_from_options({"optimizer": optimizer, "monitor": monitor}),
+        calibration=calibration, console=stdout_console(), status=status, params=params,
     )  # fmt: skip
