@@ -262,11 +262,11 @@ def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_sa
 
 
 def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):
+    from emaphm.identification import limits
     from emaphm.identification.api import identify
-    from emaphm.identification.uncertainty import mcmc
 
-    monkeypatch.setattr(mcmc, "MAX_STEPS", 60)
-    monkeypatch.setattr(mcmc, "CHUNK", 30)
+    monkeypatch.setattr(limits, "MAX_STEPS", 60)
+    monkeypatch.setattr(limits, "CHUNK", 30)
     steps = []
     res = identify(
         [0.3, 0, 0, 0, 0, 0, 0, 0.5], seed=2, uncertainty="mcmc", on_generation=lambda g, t, b: steps.append(g),

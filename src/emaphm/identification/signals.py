@@ -142,7 +142,7 @@ def resample(t_src: ArrayLike, x_src: ArrayLike, t_grid: ArrayLike, f_s: float) 
     A source sampled faster than the grid (by more than `ANTI_ALIAS_ABOVE`, on a uniform grid) is
     first low-passed on its own grid (zero-phase Butterworth, order 8, at 0.4·f_s): interpolating
     first would fold the inverter's ripple above the grid's Nyquist rate into the comparison band
-    (issue 10; `benchmarks/bench_resample.py` measures it). A source at the grid's rate or
+    (issue 10; `studies/bench_resample.py` measured it). A source at the grid's rate or
     slower is interpolated as it is, so a trace on the model grid comes through unchanged.
     """
     t_src = np.asarray(t_src, dtype=np.float64)

@@ -26,6 +26,8 @@ from .intervals import N_PARAMS, PHASE, ZETA, covers, half_widths, intervals
 if TYPE_CHECKING:
     from ...calibration import Calibration
 
+from ..limits import FIT_COVERAGE
+
 __all__ = [
     "FIT_COVERAGE",
     "PACKAGED_FACTORS",
@@ -144,11 +146,6 @@ def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str 
     return Factors.from_json(data, str(p))
 
 
-# the coverage the calibration asks of its own cases: above 0.90, because choosing two factors
-# per fault on the same cases over-fits. Measured on the 160 cases of the shipped calibration,
-# 4 folds x 5 (benchmarks/uq_crossval.py): fitted to 0.90, the held-out coverage was 0.875-0.895
-# per fault; fitted to 0.92, 0.900-0.921
-FIT_COVERAGE = 0.92
 
 
 def fit_factors(

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...faults import FAULT_NAMES, HEALTHY
+from ..limits import PHASE_SIGMAS
 
 __all__ = [
     "N_PARAMS", "PHASE", "PHASE_SIGMAS", "Z90", "Z90_ONE", "ZETA", "Uncertainty", "covers", "half_widths",
@@ -22,7 +23,6 @@ __all__ = [
 
 Z90 = 1.6448536269514722  # two-sided 90 %: the 95 % normal quantile
 Z90_ONE = 1.2815515655446004  # one-sided 90 %
-PHASE_SIGMAS = 2.0  # the direction is undefined while ζ̂ < this many σ(ζ)
 N_PARAMS = len(FAULT_NAMES)
 ZETA, PHASE = 5, 6  # indices of k6 (ζ) and k7 (its direction) in the fault vector
 
