@@ -51,7 +51,7 @@ def calibrate(
     from ..calibration import load_calibration
     from ..calibration.fit_monitor import calibrate as run_calibration
     from ..io import check_output_path
-    from ..models import check_seed
+    from ..models._base import check_seed
 
     check_seed(seed)
     check_output_path(output, suffixes=(".json",), inputs=(params, start))
@@ -91,7 +91,8 @@ def calibrate_uq(
     from ..actuator import resolve_params
     from ..calibration.fit_intervals import calibrate_uq as run_calibrate_uq
     from ..io import check_output_path
-    from ..models import MonitorEma, check_seed
+    from ..models import MonitorEma
+    from ..models._base import check_seed
 
     check_seed(seed)
     if cases < 20:
