@@ -79,6 +79,13 @@ def as_fault_vector(k: ArrayLike, *, name: str = "fault vector") -> NDArray[np.f
 
     Raises `InputError` with a one-line reason for a wrong length, a non-number, NaN/inf or a value
     outside [0, 1].
+
+    Parameters
+    ----------
+    k : array_like of 8 floats
+        The values to check.
+    name : str
+        What `k` is, for the error message (e.g. ``"scenario 'a'"``).
     """
     try:
         arr = np.array(k, dtype=np.float64)
@@ -161,7 +168,15 @@ def fault_parameter_columns(K: NDArray[np.float64], params: EmaParams) -> dict[s
 
 
 def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
-    """Map a fault vector to the physical parameters it changes (DESIGN §2)."""
+    """Map a fault vector to the physical parameters it changes (DESIGN §2).
+
+    Parameters
+    ----------
+    k : array_like of 8 floats in [0, 1]
+        The fault vector k1..k8 (checked by `as_fault_vector`).
+    params : EmaParams
+        The healthy actuator whose parameters the faults change.
+    """
     col = {
         name: float(v[0]) for name, v in fault_parameter_columns(as_fault_vector(k)[None, :], params).items()
     }

@@ -42,7 +42,8 @@ from ..identification.detection import DETECTABLE, detect
 from ..identification.last_stage import resolve_last_stage
 from ..identification.weights import resolve_error_corner
 from ..io import atomic_path, check_output_path
-from ..models import MonitorEma, check_seed
+from ..models import MonitorEma
+from ..models._base import check_seed
 from ..params import EmaParams
 from .files import Calibration, params_hash
 
@@ -85,10 +86,14 @@ def calibrate_detection(
     `params` is the actuator (`EmaParams` or an actuator file), `calibration` its LF calibration
     (the packaged one by default, for the nominal actuator only) and `monitor` the monitor model
     (None: the calibration's). `pop_size`/`generations` set the search's budget (None: identify's
-    defaults for `optimizer`), `workers` its threads. `on_progress(stage, done, total)` is called
-    after each identification. The record (the thresholds file's content) is returned and, with
-    `output`, written there atomically (a ``.json`` file; the package's own is
-    ``src/emaphm/data/detection.json``). Bad input raises `InputError` before any work.
+    defaults for `optimizer`), `workers` its numba threads (None: all cores). `on_progress` (stage,
+    done, total) is called after each identification. The record (the thresholds file's content)
+    is returned and, with `output`, written there atomically (a ``.json`` file; the package's own
+    is ``src/emaphm/data/detection.json``). Bad input raises `InputError` before any work.
+
+    `runs` healthy identifications set the thresholds (seeds from `threshold_seed`), as many fresh
+    ones measure the false-alarm rate (from `false_alarm_seed`), and single-fault runs check the
+    sensitivity (from `sensitivity_seed`; None: not checked).
     """
     start = time.perf_counter()
     settings = {
