@@ -156,7 +156,7 @@ def intervals(
 
 
 def verdicts(
-    k_hat: ArrayLike, low: ArrayLike, high: ArrayLike, thresholds: dict[str, float]
+    estimate: ArrayLike, low: ArrayLike, high: ArrayLike, thresholds: dict[str, float]
 ) -> dict[str, str]:
     """Per detectable fault: "present" when its 90 % interval excludes the healthy value by more than
     the threshold, "absent" when the estimate is within the threshold of healthy, else "cannot tell"
@@ -164,14 +164,14 @@ def verdicts(
 
     Parameters
     ----------
-    k_hat : array_like of 8 floats in [0, 1]
-        The estimate.
+    estimate : array_like of 8 floats in [0, 1]
+        The identified fault vector k1..k8.
     low, high : array_like of 8 floats
         The ends of the 90 % intervals (`Uncertainty.ci90_low`, `Uncertainty.ci90_high`).
     thresholds : dict of str to float
         The detection threshold of each fault, in fault units above healthy (`detect`).
     """
-    k, lo, hi = (np.asarray(a, dtype=np.float64) for a in (k_hat, low, high))
+    k, lo, hi = (np.asarray(a, dtype=np.float64) for a in (estimate, low, high))
     out: dict[str, str] = {}
     for j, name in enumerate(FAULT_NAMES):
         if name not in thresholds:
