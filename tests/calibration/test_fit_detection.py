@@ -41,7 +41,7 @@ def test_the_thresholds_follow_the_rule_and_the_record_says_what_made_them(tmp_p
     monkeypatch.setattr(fit_detection, "identify", identify)
     progress = []
     out = tmp_path / "detection.json"
-    record = calibrate_detection(runs=2, output=out, on_progress=lambda *a: progress.append(a), pop_size=4)
+    record = calibrate_detection(runs=2, output=out, progress=lambda *a: progress.append(a), pop_size=4)
     assert record["thresholds"]["friction"] == round(1.25 * 0.008 + 0.005, 4)
     assert record["thresholds"]["kp_drift"] == round(1.25 * 0.002 + 0.005, 4)
     assert record["thresholds"]["backlash"] == 0.005  # no departure: the 0.005 margin alone
