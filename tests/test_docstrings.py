@@ -17,6 +17,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import re
+from pathlib import Path
 
 import pytest
 
@@ -101,3 +102,9 @@ def test_the_check_finds_an_undocumented_parameter() -> None:
     assert _missing(documented) == ["options"]
     documented.__doc__ += "options\n    Settings' fields as keywords.\n"
     assert _missing(documented) == []
+
+
+def test_the_conventions_page_names_the_public_packages():
+    page = (Path(__file__).resolve().parents[1] / "docs" / "conventions.md").read_text()
+    section = page.split("## Public names", 1)[1].split("\n## ", 1)[0]
+    assert all(f"`{package}`" in section for package in PUBLIC), "docs/conventions.md: Public names"
