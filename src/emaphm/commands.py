@@ -103,7 +103,7 @@ class ChirpHold(Chirp):
     A rig that runs the FDI chirp and then parks the surface records this (issue 8, item 5).
 
     A_max, V_max, f0, f1, T, t_f : float  the chirp's (`Chirp`) [rad], [rad/s], [Hz], [Hz], [s], [s]
-    hold : float  time at rest after the sweep, the ramp included [s]
+    hold : float  time after the sweep, the ramp back included [s]
     ramp : float  time of the ramp back to zero [s]
     """
 
