@@ -177,9 +177,8 @@ def apply_faults(faults: ArrayLike, params: EmaParams) -> FaultedParameters:
     params : EmaParams
         The healthy actuator whose parameters the faults change.
     """
-    col = {
-        name: float(v[0]) for name, v in fault_parameter_columns(as_fault_vector(faults)[None, :], params).items()
-    }
+    K = as_fault_vector(faults)[None, :]
+    col = {name: float(v[0]) for name, v in fault_parameter_columns(K, params).items()}
     return FaultedParameters(
         F_S=col["F_S"], F_D=col["F_D"], B=col["B"], N=(col["N_A"], col["N_B"], col["N_C"]),
         zeta=col["zeta"], phi_e=col["phi_e"], K_P=col["K_P"],

@@ -239,8 +239,8 @@ def space_mapping(
     history = [it[2] for it in iterates]
     best = int(np.argmin(np.asarray(history) + smooth))
     x, current, fitness, corrected = iterates[best]
-    keep = objective.weights > 0
-    fit_nrmse = float(nrmse(objective.comparison.reference[keep], objective.comparison.filtered(current)[keep]))
+    keep, measured = objective.weights > 0, objective.comparison
+    fit_nrmse = float(nrmse(measured.reference[keep], measured.filtered(current)[keep]))
     return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history,
                           [float(v) for v in smooth], stopped, [it[0] for it in iterates])  # fmt: skip
 
