@@ -30,7 +30,8 @@ from .identification.api import identify
 from .identification.detection import detect
 from .identification.metrics import percent_error
 from .identification.settings import IdentifySettings
-from .models import MonitorEma, check_seed, simulate
+from .models import MonitorEma, simulate
+from .models._base import check_seed
 from .params import EmaParams
 from .plots import plot_convergence, plot_fit, plot_response, plot_vectors
 from .tables import fault_table

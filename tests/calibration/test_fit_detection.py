@@ -43,7 +43,7 @@ def test_the_thresholds_follow_the_rule_and_the_record_says_what_made_them(tmp_p
     progress = []
     out = tmp_path / "detection.json"
     record = calibrate_detection(
-        runs=2, output=out, on_progress=lambda *a: progress.append(a), settings=IdentifySettings(pop_size=4)
+        runs=2, output=out, progress=lambda *a: progress.append(a), settings=IdentifySettings(pop_size=4)
     )
     assert record["thresholds"]["friction"] == round(1.25 * 0.008 + 0.005, 4)
     assert record["thresholds"]["kp_drift"] == round(1.25 * 0.002 + 0.005, 4)

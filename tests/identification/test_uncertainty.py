@@ -66,7 +66,7 @@ class LinearObjective:
 
     def __init__(self, fitness: Fitness) -> None:
         self.f = fitness
-        self.weights, self.reference = fitness.weights, fitness.reference
+        self.weights, self.comparison = fitness.weights, fitness.comparison
 
     def of_monitor(self, monitor, K, *, duration=None):
         return self.f(monitor.simulate_many(K))
@@ -87,9 +87,9 @@ def test_laplace_intervals_of_a_linear_gaussian_oracle_cover_90_percent():
         measured = u_true @ monitor.G + rng.normal(0.0, 0.05, n)
         fit = Fitness(Comparison.from_signal(t, measured, F_S))
         # the least-squares estimate: weighted regression on the filtered regressors
-        Gf = fit.reference.filtered(monitor.G)
+        Gf = fit.comparison.filtered(monitor.G)
         sw = np.sqrt(fit.weights)
-        u_hat = np.linalg.lstsq((Gf * sw).T, fit.reference.reference * sw, rcond=None)[0]
+        u_hat = np.linalg.lstsq((Gf * sw).T, fit.comparison.reference * sw, rcond=None)[0]
         k_hat = to_faults(u_hat)[0]
         res = laplace(fit, monitor, k_hat)  # type: ignore[arg-type]
         ok = covers(res.ci90_low, res.ci90_high, truth)

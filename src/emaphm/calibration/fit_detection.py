@@ -42,7 +42,8 @@ from ..identification.last_stage import resolve_last_stage
 from ..identification.settings import IdentifySettings
 from ..identification.weights import resolve_error_corner
 from ..io import atomic_path, check_output_path
-from ..models import MonitorEma, check_seed
+from ..models import MonitorEma
+from ..models._base import check_seed
 from ..params import EmaParams
 from .files import Calibration, params_hash
 
@@ -73,7 +74,7 @@ def calibrate_detection(
     threshold_seed: int = THRESHOLD_SEED,
     false_alarm_seed: int = FALSE_ALARM_SEED,
     sensitivity_seed: int | None = SENSITIVITY_SEED,
-    on_progress: Progress | None = None,
+    progress: Progress | None = None,
     output: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Measure the detection thresholds (about 5 s per identification, 2·`runs` + 14 of them).
@@ -83,7 +84,7 @@ def calibrate_detection(
     identification runs (`IdentifySettings`: the monitor, the optimiser, its budget and threads;
     its seed is replaced by each run's). `runs` healthy runs from `threshold_seed` give the
     thresholds, as many from `false_alarm_seed` the false alarms, and single faults from
-    `sensitivity_seed` (None: skipped) the sensitivity. `on_progress(stage, done, total)` is
+    `sensitivity_seed` (None: skipped) the sensitivity. `progress` (stage, done, total) is
     called after each identification. The record (the thresholds file's content) is returned and,
     with `output`, written there atomically (a ``.json`` file; the package's own is
     ``src/emaphm/data/detection.json``). Bad input raises `InputError` before any work.
@@ -94,7 +95,7 @@ def calibrate_detection(
             "sensitivity_seed": sensitivity_seed}  # fmt: skip
     actuator, lf = _checked(params, calibration, s.monitor, sets, output)
     run = functools.partial(identify, settings=s, calibration=calibration, params=actuator, thresholds={})
-    measured = _measure(run, runs, threshold_seed, false_alarm_seed, sensitivity_seed, on_progress)
+    measured = _measure(run, runs, threshold_seed, false_alarm_seed, sensitivity_seed, progress)
     record = {
         "thresholds": measured.pop("thresholds"),
         "monitor": lf.monitor,  # identify() warns when another monitor uses these thresholds
@@ -129,15 +130,15 @@ def _measure(
     threshold_seed: int,
     false_alarm_seed: int,
     sensitivity_seed: int | None,
-    on_progress: Progress | None,
+    progress: Progress | None,
 ) -> dict[str, Any]:
     """Steps 1-3 of the module's method: the thresholds, the false alarms, the sensitivity."""
-    fit = _healthy_estimates(run, threshold_seed, runs, "healthy runs (thresholds)", on_progress)
+    fit = _healthy_estimates(run, threshold_seed, runs, "healthy runs (thresholds)", progress)
     deviation = np.abs(fit - HEALTHY)[:, [FAULT_NAMES.index(n) for n in DETECTABLE]]
     thresholds = {
         name: round(1.25 * float(deviation[:, j].max()) + 0.005, 4) for j, name in enumerate(DETECTABLE)
     }
-    check = _healthy_estimates(run, false_alarm_seed, runs, "healthy runs (false alarms)", on_progress)
+    check = _healthy_estimates(run, false_alarm_seed, runs, "healthy runs (false alarms)", progress)
     alarms = [detect(k, thresholds) for k in check]
     return {
         "thresholds": thresholds,
@@ -148,7 +149,7 @@ def _measure(
         "healthy_estimates_check_set": check.round(5).tolist(),
         "sensitivity": None
         if sensitivity_seed is None
-        else _sensitivity(run, thresholds, sensitivity_seed, on_progress),
+        else _sensitivity(run, thresholds, sensitivity_seed, progress),
     }
 
 
@@ -179,19 +180,19 @@ def _checked(
 
 
 def _healthy_estimates(
-    run: Identify, first_seed: int, runs: int, stage: str, on_progress: Progress | None
+    run: Identify, first_seed: int, runs: int, stage: str, progress: Progress | None
 ) -> NDArray[np.float64]:
     """The estimates of `runs` healthy identifications (noise on), seeds `first_seed`.. (one row each)."""
     out = []
     for j, seed in enumerate(range(first_seed, first_seed + runs)):
         out.append(run(HEALTHY, seed=seed).estimate)
-        if on_progress is not None:
-            on_progress(stage, j + 1, runs)
+        if progress is not None:
+            progress(stage, j + 1, runs)
     return np.array(out)
 
 
 def _sensitivity(
-    run: Identify, thresholds: dict[str, float], seed: int, on_progress: Progress | None
+    run: Identify, thresholds: dict[str, float], seed: int, progress: Progress | None
 ) -> list[dict[str, Any]]:
     """Single faults of 0.1 and 0.2 (k8: 0.6, 0.7; eccentricity at phase 0.3), one run each: detected?"""
     out: list[dict[str, Any]] = []
@@ -204,8 +205,8 @@ def _sensitivity(
                 k[6] = 0.3
             found = detect(run(k, seed=seed).estimate, thresholds)
             out.append({"fault": name, "value": float(k[i]), "detected": found})
-            if on_progress is not None:
-                on_progress("sensitivity (single faults)", len(out), 2 * len(DETECTABLE))
+            if progress is not None:
+                progress("sensitivity (single faults)", len(out), 2 * len(DETECTABLE))
     return out
 
 

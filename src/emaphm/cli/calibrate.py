@@ -52,7 +52,7 @@ def calibrate(
     from ..calibration import load_calibration
     from ..calibration.fit_monitor import calibrate as run_calibration
     from ..io import check_output_path
-    from ..models import check_seed
+    from ..models._base import check_seed
 
     check_seed(seed)
     check_output_path(output, suffixes=(".json",), inputs=(params, start))
@@ -92,7 +92,8 @@ def calibrate_uq(
     from ..actuator import resolve_params
     from ..calibration.fit_intervals import calibrate_uq as run_calibrate_uq
     from ..io import check_output_path
-    from ..models import MonitorEma, check_seed
+    from ..models import MonitorEma
+    from ..models._base import check_seed
 
     check_seed(seed)
     if cases < 20:
@@ -150,7 +151,7 @@ def calibrate_detection(
         record = run_calibrate_detection(
             params=params, calibration=calibration, settings=settings, runs=runs, threshold_seed=seed,
             false_alarm_seed=seed + 1000, sensitivity_seed=seed + 2000 if sensitivity else None,
-            on_progress=report, output=output,
+            progress=report, output=output,
         )  # fmt: skip
     for name, value in record["thresholds"].items():
         err.print(f"{name}: threshold {value:g}")

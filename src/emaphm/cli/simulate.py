@@ -50,7 +50,8 @@ def simulate(
     from ..commands import make_command
     from ..faults import describe, parse_faults
     from ..io import TRACE_SUFFIXES, check_output_path, write_trace
-    from ..models import check_seed, make_model
+    from ..models import make_model
+    from ..models._base import check_seed
 
     k = parse_faults(faults)
     check_seed(seed)

@@ -211,10 +211,10 @@ def space_mapping(
     current, f = switching_fit(x)
     # each iterate: its point, the switching model's current and eq. 3 there, the corrected eq. 3
     iterates = [(x, current, f, objective)]
-    d_mean, evaluations, stopped = np.zeros_like(objective.reference.reference), 0, "all iterations run"
+    d_mean, evaluations, stopped = np.zeros_like(objective.comparison.reference), 0, "all iterations run"
     for j in range(iterations):
         try:
-            d = objective.reference.filtered(current - monitor_current(to_faults(x[None, :])[0]))
+            d = objective.comparison.filtered(current - monitor_current(to_faults(x[None, :])[0]))
         except SimulationError:
             stopped = f"the monitor diverged at iterate {j}"
             break
@@ -239,8 +239,8 @@ def space_mapping(
     history = [it[2] for it in iterates]
     best = int(np.argmin(np.asarray(history) + smooth))
     x, current, fitness, corrected = iterates[best]
-    keep = objective.weights > 0
-    fit_nrmse = float(nrmse(objective.reference.reference[keep], objective.reference.filtered(current)[keep]))
+    keep, measured = objective.weights > 0, objective.comparison
+    fit_nrmse = float(nrmse(measured.reference[keep], measured.filtered(current)[keep]))
     return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history,
                           [float(v) for v in smooth], stopped, [it[0] for it in iterates])  # fmt: skip
 

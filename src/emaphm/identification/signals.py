@@ -105,7 +105,19 @@ def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
 
 def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = -1) -> NDArray[np.float64]:
     """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`: the numbers of
-    ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``."""
+    ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``.
+
+    Parameters
+    ----------
+    x : array_like
+        The signal(s), sampled at `f_s`.
+    f_s : float
+        Sample rate [Hz].
+    cutoff : float
+        Cut-off frequency [Hz].
+    axis : int
+        The time axis of `x`.
+    """
     sos, zi, pad = comparison_filter(f_s, cutoff)
     a = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
     n = a.shape[-1]
@@ -121,7 +133,17 @@ def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = 
 
 
 def nrmse(reference: ArrayLike, estimate: ArrayLike, *, axis: int = -1) -> NDArray[np.float64] | float:
-    """‖ref − est‖ ⁄ ‖ref − mean(ref)‖ along `axis` (inputs already filtered and on one grid)."""
+    """‖ref − est‖ ⁄ ‖ref − mean(ref)‖ along `axis` (inputs already filtered and on one grid).
+
+    Parameters
+    ----------
+    reference : array_like
+        The reference signal (the measured or HF current) [A].
+    estimate : array_like
+        The model's signal on the same grid [A].
+    axis : int
+        The time axis.
+    """
     ref = np.asarray(reference, dtype=np.float64)
     est = np.asarray(estimate, dtype=np.float64)
     scale = np.linalg.norm(ref - ref.mean(axis=axis, keepdims=True), axis=axis)

@@ -125,7 +125,7 @@ def laplace(
     factors = factors if factors is not None else Factors.identity()
     keep = objective.weights > 0
     sw = np.sqrt(objective.weights[keep])
-    ref = objective.reference.reference[keep]
+    ref = objective.comparison.reference[keep]
     n = int(keep.sum())
     rows = [u0]
     spans = []
@@ -141,7 +141,7 @@ def laplace(
             spans.append(up[j] - down[j])
     K = np.clip(to_faults(np.array(rows)), 0.0, 1.0)
     currents = monitor.simulate_many(K, duration=duration, check=False)
-    R = sw * (ref - objective.reference.filtered(currents)[:, keep])
+    R = sw * (ref - objective.comparison.filtered(currents)[:, keep])
     r0 = R[0]
     if not np.all(np.isfinite(r0)):
         raise InputError("the monitor diverges at the estimate: no uncertainty can be given")
