@@ -146,7 +146,7 @@ def calibrate_uq(
             "created": lf.record.get("created"),
             "params_hash": lf.params_hash,
         },
-        # the eq. 3 frequency weights the identifications used (`fitness.error_weights`)
+        # the eq. 3 frequency weights the identifications used (`weights.error_weights`)
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),
         # the last stage the identifications ran (`switching`): it sets how far estimates fall
         # from the truth, so intervals fitted with one do not hold for the other

@@ -181,7 +181,7 @@ MAY_REST_CARRY = 0.5
 
 # No zero vector holds beyond |i_q,ref| = RING_OUTER · i_D at any angle: one holds while
 # |i_q,ref| · min(max_x u_x, −min_x u_x) < i_D (`standstill_dead_zone`), and that min is smallest,
-# 1/2, where one phase direction is ±1 and the other two ∓1/2. `fitness.moving_mask` leaves out the
+# 1/2, where one phase direction is ±1 and the other two ∓1/2. `weights.moving_mask` leaves out the
 # rests whose measured current is below this edge: there the twin's current is a coin flip.
 RING_OUTER = 2.0
 

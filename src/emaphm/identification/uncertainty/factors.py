@@ -111,7 +111,7 @@ class Factors:
         )
 
 
-# the packaged interval calibrations, by the identification's last stage (`switching.LAST_STAGES`):
+# the packaged interval calibrations, by the identification's last stage (`choices.LAST_STAGES`):
 # the switching stage leaves estimates about half as far from the truth, so its intervals are
 # narrower; the other file was fitted without it (both with the packaged LF calibration)
 PACKAGED_FACTORS = {"switching": "uq_calibration.json", "none": "uq_calibration_no_last_stage.json"}
