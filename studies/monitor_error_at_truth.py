@@ -147,7 +147,7 @@ def rest_share(ident: FaultIdentifier, k: np.ndarray, trace: object) -> tuple[fl
     before = moving_mask(theta, f_s, theta_u=position) * band_mask(theta, f_s)
     after = np.zeros_like(before)
     after[: len(ident.mask_)] = ident.mask_
-    fitness = Fitness(whole, ident.slope_unit, before, error_weights(theta, f_s, ident.error_corner_hz_))
+    fitness = Fitness(whole, ident.settings.slope_unit, before, error_weights(theta, f_s, ident.error_corner_hz_))
     at_truth = whole.filtered(monitor.simulate(k, duration=float(grid[-1] - grid[0])).i_q)
     cost = fitness.weights * (whole.reference - at_truth) ** 2
     gone = (before > 0) & (after == 0)

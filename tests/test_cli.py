@@ -79,10 +79,11 @@ def test_demo_runs_and_writes_its_figures(tmp_path):
     from rich.console import Console
 
     from emaphm.demo import run_demo
+    from emaphm.identification.settings import IdentifySettings
 
     console = Console(record=True, width=160)
     budget = {"pop_size": 16, "generations": 3, "polish": False}  # the table, not convergence
-    data = run_demo(tmp_path / "demo", runs=2, console=console, budget=budget)
+    data = run_demo(tmp_path / "demo", runs=2, console=console, settings=IdentifySettings(**budget))
     for name in ("hf_table1.png", "identified_current.png", "convergence.png", "identified_vs_true.png"):
         assert (tmp_path / "demo" / name).stat().st_size > 10_000
     out = console.export_text()
@@ -402,7 +403,7 @@ def test_calibrate_and_identify_refuse_an_unknown_monitor_before_any_work(tmp_pa
     assert code == 2 and "unknown monitor 'exact'" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
     code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--monitor", "exact"], capsys)
-    assert code == 2 and "unknown monitor 'exact'" in err
+    assert code == 2 and "unknown --monitor 'exact'" in err
 
 
 def test_calibrate_uq_refuses_too_few_cases_before_the_work(tmp_path, capsys):
@@ -427,3 +428,26 @@ def test_identify_refuses_a_recording_faster_than_the_monitor_was_fitted_on(tmp_
     code, _, err = run_cli(["identify", "--reference", str(trace), "--output", str(out), *FAST], capsys)
     assert code == 2 and "faster than the 10 Hz" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.slow  # two identifications, ~4 s
+def test_calibrate_detection_writes_thresholds_identify_can_load(tmp_path, capsys, monkeypatch):
+    # the command replaces benchmarks/detection_thresholds.py; a tiny search keeps it to seconds
+    import json
+
+    from emaphm.calibration import params_hash
+    from emaphm.identification import limits
+    from emaphm.identification.detection import DETECTABLE, load_thresholds
+
+    monkeypatch.setitem(limits.DEFAULT_BUDGETS, "ga", (8, 1))
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
+    out = tmp_path / "detection.json"
+    code, _, err = run_cli(["calibrate-detection", "--runs", "1", "--no-sensitivity", "--output", str(out)], capsys)
+    assert code == 0 and f"wrote {out}" in " ".join(err.split())
+    record = json.loads(out.read_text())
+    assert set(record["thresholds"]) == set(DETECTABLE) and record["runs"] == 1 and record["sensitivity"] is None
+    assert record["params_hash"] == params_hash(emaphm.EmaParams()) and record["threshold_seeds"] == [1000, 1000]
+    assert dict(load_thresholds(out)["thresholds"]) == record["thresholds"]
+    code, _, err = run_cli(["calibrate-detection", "--runs", "0", "--output", str(tmp_path / "no.json")], capsys)
+    assert code == 2 and "runs must be" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "no.json").exists()

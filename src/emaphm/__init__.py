@@ -13,7 +13,16 @@ The public API:
 - `identify` / `FaultIdentifier` find the fault vector from a measured current (DESIGN §5), run
   as `IdentifySettings` say, and
   `percent_error` scores it (paper eq. 4, the reading that reproduces Table 1);
-- `calibrate` fits the monitor model to the twin, `load_calibration` reads such a file.
+- `Uncertainty` holds the 90 % intervals of a result, `verdicts` turns them into each fault's verdict;
+- `calibrate` fits the monitor model to the twin, `load_calibration` reads such a file;
+  `calibrate_uq` fits the intervals' scale and floor, `calibrate_detection` the detection thresholds;
+- `load_params` reads an actuator file into `EmaParams`;
+- `ChannelMap`, `load_measurement`, `to_reference` turn a rig's recording into a reference trace;
+- `run_campaign` runs a fleet campaign into a results store, `rul_report` reads the remaining useful
+  life from it, `derive_thresholds` finds each fault's failure threshold from the requirements.
+
+The subpackages `identification`, `calibration`, `measured`, `campaign`, `prognostics` and `models`
+list more in their own ``__all__`` (docs/conventions.md says what is public).
 
 The names are imported on first use (PEP 562), so ``import emaphm`` and ``emaphm --version``
 stay fast: numba kernels, scipy and pymoo load only when a name that needs them is used.
@@ -37,8 +46,14 @@ _LAZY = {
     "identify": "identification.api", "IdentifySettings": "identification.settings",
     "percent_error": "identification.metrics", "absolute_errors": "identification.metrics",
     "detect": "identification.detection",
-    "calibrate": "calibration.fit_monitor",
+    "Uncertainty": "identification.uncertainty", "verdicts": "identification.uncertainty",
+    "calibrate": "calibration.fit_monitor", "calibrate_uq": "calibration.fit_intervals",
+    "calibrate_detection": "calibration.fit_detection",
     "Calibration": "calibration", "load_calibration": "calibration",
+    "load_params": "actuator",
+    "ChannelMap": "measured", "load_measurement": "measured", "to_reference": "measured",
+    "run_campaign": "campaign",
+    "derive_thresholds": "prognostics", "rul_report": "prognostics",
     "read_trace": "io", "write_trace": "io",
     "HighFidelityEma": "models", "MonitorEma": "models", "simulate": "models",
     "ControllerParams": "params", "EmaParams": "params", "IntegrationParams": "params",
@@ -52,6 +67,7 @@ __all__ = [
     "HEALTHY",
     "TABLE1_REFERENCE",
     "Calibration",
+    "ChannelMap",
     "Chirp",
     "ChirpHold",
     "ControllerParams",
@@ -73,18 +89,28 @@ __all__ = [
     "Step",
     "Steps",
     "TransmissionParams",
+    "Uncertainty",
     "__version__",
     "absolute_errors",
     "apply_faults",
     "as_fault_vector",
     "calibrate",
+    "calibrate_detection",
+    "calibrate_uq",
+    "derive_thresholds",
     "detect",
     "identify",
     "load_calibration",
+    "load_measurement",
+    "load_params",
     "make_command",
     "percent_error",
     "read_trace",
+    "rul_report",
+    "run_campaign",
     "simulate",
+    "to_reference",
+    "verdicts",
     "write_trace",
 ]
 
@@ -103,8 +129,12 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
+    from .actuator import load_params
     from .calibration import Calibration, load_calibration
+    from .calibration.fit_detection import calibrate_detection
+    from .calibration.fit_intervals import calibrate_uq
     from .calibration.fit_monitor import calibrate
+    from .campaign import run_campaign
     from .commands import Chirp, ChirpHold, Ramp, Sine, Step, Steps, make_command
     from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE, apply_faults, as_fault_vector
     from .identification.api import identify
@@ -113,7 +143,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .identification.metrics import absolute_errors, percent_error
     from .identification.result import IdentificationResult
     from .identification.settings import IdentifySettings
+    from .identification.uncertainty import Uncertainty, verdicts
     from .io import read_trace, write_trace
+    from .measured import ChannelMap, load_measurement, to_reference
     from .models import HighFidelityEma, MonitorEma, simulate
     from .params import (
         ControllerParams,
@@ -124,4 +156,5 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         SensorParams,
         TransmissionParams,
     )
+    from .prognostics import derive_thresholds, rul_report
     from .results import SimResult

@@ -128,7 +128,13 @@ def _example_unit(si_unit: str) -> str:
 
 
 def load_params(path: str | os.PathLike[str]) -> EmaParams:
-    """Read an actuator file (TOML); `InputError` for a missing, malformed or invalid file."""
+    """Read an actuator file (TOML); `InputError` for a missing, malformed or invalid file.
+
+    Parameters
+    ----------
+    path : str or path
+        The actuator file (TOML; docs/your-actuator.md).
+    """
     from .io import read_toml
 
     return params_from_dict(read_toml(path, "actuator file"), str(path))

@@ -101,6 +101,10 @@ class ChirpHold(Chirp):
     """The chirp (`Chirp`, over T), then a ramp back to zero over `ramp` [s], then a hold to T + hold.
 
     A rig that runs the FDI chirp and then parks the surface records this (issue 8, item 5).
+
+    A_max, V_max, f0, f1, T, t_f : float  the chirp's (`Chirp`) [rad], [rad/s], [Hz], [Hz], [s], [s]
+    hold : float  time after the sweep, the ramp back included [s]
+    ramp : float  time of the ramp back to zero [s]
     """
 
     hold: float = 1.0
@@ -124,7 +128,11 @@ class ChirpHold(Chirp):
 
 @dataclass(frozen=True)
 class Steps(_Checked):
-    """A staircase: θ_cmd holds `levels[j]` [rad] over [j·dwell, (j + 1)·dwell), the last level to the end."""
+    """A staircase: θ_cmd holds `levels[j]` [rad] over [j·dwell, (j + 1)·dwell), the last level to the end.
+
+    levels : tuple of float  the positions held [rad]
+    dwell : float  time each level is held [s]
+    """
 
     levels: tuple[float, ...] = (0.0, 0.03, -0.02, 0.045, 0.0, -0.04, 0.02, -0.01, 0.035, -0.03)
     dwell: float = 0.2
@@ -153,7 +161,10 @@ class Steps(_Checked):
 
 @dataclass(frozen=True)
 class Step(_Checked):
-    """Step of `amplitude` [rad] at time `t_0` [s]."""
+    """Step of `amplitude` [rad] at time `t_0` [s].
+
+    duration : float  length of the command [s]
+    """
 
     amplitude: float = 0.02
     t_0: float = 0.01
@@ -166,7 +177,10 @@ class Step(_Checked):
 
 @dataclass(frozen=True)
 class Ramp(_Checked):
-    """Ramp of `rate` [rad/s] starting at `t_0` [s]."""
+    """Ramp of `rate` [rad/s] starting at `t_0` [s].
+
+    duration : float  length of the command [s]
+    """
 
     rate: float = 0.1
     t_0: float = 0.01
@@ -179,7 +193,10 @@ class Ramp(_Checked):
 
 @dataclass(frozen=True)
 class Sine(_Checked):
-    """Sine of `amplitude` [rad] and `frequency` [Hz], starting at zero position (with velocity 2π·f·A)."""
+    """Sine of `amplitude` [rad] and `frequency` [Hz], starting at zero position (with velocity 2π·f·A).
+
+    duration : float  length of the command [s]
+    """
 
     amplitude: float = 0.02
     frequency: float = 2.0
@@ -231,7 +248,15 @@ COMMANDS: dict[str, type] = dict(
 
 def make_command(name: str, **settings: Any) -> Command:
     """Build a command by name (``chirp``, ``chirp-hold``, ``steps``, ``step``, ``ramp``, ``sine``)
-    with optional settings."""
+    with optional settings.
+
+    Parameters
+    ----------
+    name : str
+        The command's name (above).
+    **settings
+        The command class's fields (SI: [rad], [s], [Hz]), e.g. ``make_command("sine", frequency=5.0)``.
+    """
     try:
         cls = COMMANDS[name]
     except KeyError:

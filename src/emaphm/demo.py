@@ -29,8 +29,9 @@ from .faults import FAULT_NAMES, HEALTHY, TABLE1_REFERENCE
 from .identification.api import identify
 from .identification.detection import detect
 from .identification.metrics import percent_error
-from .identification.optimizers import check_optimizer
-from .models import MonitorEma, check_seed, simulate
+from .identification.settings import IdentifySettings
+from .models import MonitorEma, simulate
+from .models._base import check_seed
 from .params import EmaParams
 from .plots import plot_convergence, plot_fit, plot_response, plot_vectors
 from .tables import fault_table
@@ -44,30 +45,29 @@ def run_demo(
     output_dir: Path,
     *,
     seed: int = 0,
-    optimizer: str = "ga",
     runs: int = 5,
+    settings: IdentifySettings | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
-    monitor: str | None = None,
     console: Console | None = None,
     status: Callable[[str], Any] | None = None,
-    budget: dict[str, Any] | None = None,
     params: EmaParams | str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run the Table 1 experiment; print its table, write its figures, return its figures.
 
-    `calibration` is the LF calibration (default: the packaged one of `monitor`, "default" or
-    "paper"); `params` the actuator (`EmaParams` or an actuator file; its calibration must be
-    given too, see `emaphm.actuator`); `budget` passes
-    ``pop_size``, ``generations`` and ``polish`` to `identify` (the defaults otherwise:
-    tests use a small one).
+    `seed` is the measurement noise's; `runs` identifications run with optimiser seeds 1..runs
+    and `settings` (`IdentifySettings`: the optimiser, the monitor, the budget; identify's
+    defaults otherwise, tests use a small budget). `calibration` is the LF calibration (default:
+    the packaged one of the settings' monitor); `params` the actuator (`EmaParams` or an actuator
+    file; its calibration must be given too, see `emaphm.actuator`). `console` prints the table,
+    `status(message)` shows what runs.
     """
     console = console or Console()
     output_dir = Path(output_dir)
-    _check_inputs(output_dir, runs=runs, optimizer=optimizer, seed=seed)
+    s = settings if settings is not None else IdentifySettings()
+    optimizer = s.optimizer
+    _check_inputs(output_dir, runs=runs, seed=seed)
     actuator = resolve_params(params)
-    monitor_model = MonitorEma(
-        actuator, calibration=calibration, monitor=monitor
-    )  # refused now if it does not fit
+    monitor_model = MonitorEma(actuator, calibration=calibration, monitor=s.monitor)  # refused now if it does not fit
 
     def stage(message: str) -> Any:
         return status(message) if status else nullcontext()
@@ -81,12 +81,8 @@ def run_demo(
         with stage(f"identification {run_seed}/{runs} ({optimizer.upper()}, seed {run_seed})"):
             results.append(
                 identify(
-                    reference=measured,
-                    optimizer=optimizer,
-                    seed=run_seed,
-                    calibration=monitor_model.calibration,
+                    reference=measured, settings=s, seed=run_seed, calibration=monitor_model.calibration,
                     params=actuator,
-                    **(budget or {}),
                 )
             )
     errors = [percent_error(r.estimate, truth) for r in results]
@@ -107,7 +103,7 @@ def run_demo(
     }
 
 
-def _check_inputs(output_dir: Path, *, runs: int, optimizer: str, seed: int) -> None:
+def _check_inputs(output_dir: Path, *, runs: int, seed: int) -> None:
     """Refuse, before the work, an output folder that cannot be written and bad run settings."""
     if output_dir.exists() and not output_dir.is_dir():
         raise InputError(f"--output-dir {output_dir} exists and is not a folder")
@@ -116,7 +112,6 @@ def _check_inputs(output_dir: Path, *, runs: int, optimizer: str, seed: int) -> 
         raise InputError(f"--output-dir {output_dir}: {existing} is not writable")
     if runs < 1:
         raise InputError(f"runs must be >= 1, got {runs}")
-    check_optimizer(optimizer)
     check_seed(seed)
 
 

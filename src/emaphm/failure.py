@@ -41,7 +41,16 @@ PLACEHOLDER_THRESHOLDS: dict[str, float] = {
 def parse_thresholds(
     items: list[str] | dict[str, Any] | None, where: str = "--threshold"
 ) -> dict[str, float]:
-    """{"friction": 0.45, ...} from ``["friction=0.45", ...]`` or a dict; `InputError` naming a bad one."""
+    """{"friction": 0.45, ...} from ``["friction=0.45", ...]`` or a dict; `InputError` naming a bad one.
+
+    Parameters
+    ----------
+    items : list of str, dict or None
+        ``["friction=0.45", ...]`` or ``{"friction": 0.45, ...}``: fault name -> threshold in fault
+        units from healthy (None: {}).
+    where : str
+        The option or table they came from, for the error message.
+    """
     if not items:
         return {}
     pairs = items.items() if isinstance(items, dict) else (_split(s, where) for s in items)

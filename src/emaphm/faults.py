@@ -74,16 +74,23 @@ N_MIN = 0.05
 """Smallest fraction of healthy turns kept in a shorted coil (DESIGN §3.6): N_x = max(1 − k, N_MIN)."""
 
 
-def as_fault_vector(k: ArrayLike, *, name: str = "fault vector") -> NDArray[np.float64]:
-    """Validate and return k as a new float array of 8 values in [0, 1].
+def as_fault_vector(faults: ArrayLike, *, name: str = "fault vector") -> NDArray[np.float64]:
+    """Validate and return `faults` as a new float array of 8 values in [0, 1].
 
     Raises `InputError` with a one-line reason for a wrong length, a non-number, NaN/inf or a value
     outside [0, 1].
+
+    Parameters
+    ----------
+    faults : array_like of 8 floats
+        The values to check.
+    name : str
+        What `faults` is, for the error message (e.g. ``"scenario 'a'"``).
     """
     try:
-        arr = np.array(k, dtype=np.float64)
+        arr = np.array(faults, dtype=np.float64)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be 8 numbers, got {k!r}") from None
+        raise InputError(f"{name} must be 8 numbers, got {faults!r}") from None
     if arr.ndim != 1 or arr.size != len(FAULT_NAMES):
         raise InputError(f"{name} must have {len(FAULT_NAMES)} values (k1..k8), got {arr.size}")
     bad = ~np.isfinite(arr)
@@ -160,11 +167,18 @@ def fault_parameter_columns(K: NDArray[np.float64], params: EmaParams) -> dict[s
     }
 
 
-def apply_faults(k: ArrayLike, params: EmaParams) -> FaultedParameters:
-    """Map a fault vector to the physical parameters it changes (DESIGN §2)."""
-    col = {
-        name: float(v[0]) for name, v in fault_parameter_columns(as_fault_vector(k)[None, :], params).items()
-    }
+def apply_faults(faults: ArrayLike, params: EmaParams) -> FaultedParameters:
+    """Map a fault vector to the physical parameters it changes (DESIGN §2).
+
+    Parameters
+    ----------
+    faults : array_like of 8 floats in [0, 1]
+        The fault vector k1..k8 (checked by `as_fault_vector`).
+    params : EmaParams
+        The healthy actuator whose parameters the faults change.
+    """
+    K = as_fault_vector(faults)[None, :]
+    col = {name: float(v[0]) for name, v in fault_parameter_columns(K, params).items()}
     return FaultedParameters(
         F_S=col["F_S"], F_D=col["F_D"], B=col["B"], N=(col["N_A"], col["N_B"], col["N_C"]),
         zeta=col["zeta"], phi_e=col["phi_e"], K_P=col["K_P"],

@@ -154,6 +154,11 @@ def read_trace(path: str | os.PathLike[str]) -> SimResult:
     Raises `InputError` for a missing or unreadable file, missing required signals
     (t, theta_cmd, i_q; theta_u is optional), signals of unequal length, NaN/inf values or a time axis that
     is not strictly increasing.
+
+    Parameters
+    ----------
+    path : str or path
+        A ``.h5`` file, or a ``.csv`` file with its ``.json`` metadata beside it.
     """
     p = check_trace_path(path, for_writing=False)
     try:

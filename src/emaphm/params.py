@@ -223,7 +223,15 @@ class IntegrationParams(_Validated):
 
 @dataclass(frozen=True)
 class EmaParams(_Validated):
-    """All parameters of the EMA, grouped as the block diagram."""
+    """All parameters of the EMA, grouped as the block diagram.
+
+    motor : MotorParams  the PMSM
+    inverter : InverterParams  the two-level inverter and its hysteresis comparators
+    transmission : TransmissionParams  gearbox and user load
+    controller : ControllerParams  the control electronics: sampled PID position loop, sample rate f_s
+    sensors : SensorParams  ADC quantisation and measurement noise
+    integration : IntegrationParams  the HF twin's fixed step
+    """
 
     motor: MotorParams = field(default_factory=MotorParams)
     inverter: InverterParams = field(default_factory=InverterParams)

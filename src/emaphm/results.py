@@ -39,6 +39,10 @@ class SimResult:
     Signals are reached as attributes (``result.i_q``) or by name (``result["i_a"]``).
     Measured signals (``theta_u``, ``i_a``, ``i_b``, ``i_c``, ``i_q``) carry the ADC and, when
     enabled, the noise; ``theta_u_true`` and ``T_m`` are the simulator's internal truth.
+
+    t : ndarray  sample times [s]
+    signals : mapping of str to ndarray  each signal on `t`, in SI (`UNITS`)
+    metadata : mapping  what produced them (model, faults, seed, parameters, command, ...)
     """
 
     t: NDArray[np.float64]

@@ -11,6 +11,7 @@ from emaphm import EmaParams, InputError
 from emaphm.calibration import calibrate_detection, fit_detection, params_hash
 from emaphm.faults import HEALTHY
 from emaphm.identification.detection import DETECTABLE, load_thresholds
+from emaphm.identification.settings import IdentifySettings
 
 
 def offset(**changes):
@@ -25,8 +26,8 @@ def fake_identify(offsets):
     """identify() replaced by one that returns healthy + offsets[seed] (zeros for unknown seeds)."""
     calls = []
 
-    def identify(k, *, seed, **settings):
-        calls.append((np.array(k), seed, settings))
+    def identify(k, *, seed, settings, **inputs):
+        calls.append((np.array(k), seed, {**inputs, **settings.to_json()}))
         return SimpleNamespace(estimate=np.array(k) + offsets.get(seed, 0.0))
 
     return identify, calls
@@ -41,7 +42,9 @@ def test_the_thresholds_follow_the_rule_and_the_record_says_what_made_them(tmp_p
     monkeypatch.setattr(fit_detection, "identify", identify)
     progress = []
     out = tmp_path / "detection.json"
-    record = calibrate_detection(runs=2, output=out, on_progress=lambda *a: progress.append(a), pop_size=4)
+    record = calibrate_detection(
+        runs=2, output=out, progress=lambda *a: progress.append(a), settings=IdentifySettings(pop_size=4)
+    )
     assert record["thresholds"]["friction"] == round(1.25 * 0.008 + 0.005, 4)
     assert record["thresholds"]["kp_drift"] == round(1.25 * 0.002 + 0.005, 4)
     assert record["thresholds"]["backlash"] == 0.005  # no departure: the 0.005 margin alone
@@ -64,7 +67,8 @@ def test_the_thresholds_follow_the_rule_and_the_record_says_what_made_them(tmp_p
 @pytest.mark.slow  # ~4 s: two identifications of the healthy twin at a tiny budget
 def test_a_tiny_real_run_writes_a_loadable_file(tmp_path):
     out = tmp_path / "thresholds.json"
-    record = calibrate_detection(runs=1, sensitivity_seed=None, pop_size=4, generations=1, output=out)
+    tiny = IdentifySettings(pop_size=4, generations=1)
+    record = calibrate_detection(runs=1, sensitivity_seed=None, settings=tiny, output=out)
     read = load_thresholds(out)
     assert set(read["thresholds"]) == set(DETECTABLE)
     assert all(v >= 0.005 for v in read["thresholds"].values())
@@ -85,11 +89,11 @@ OTHER = EmaParams.from_dict(
         ({"threshold_seed": -1}, "seed must be a whole number"),
         ({"sensitivity_seed": 1.5}, "seed must be a whole number"),
         ({"false_alarm_seed": 1010}, "false-alarm runs must be fresh: seeds 1010..1029 overlap"),
-        ({"optimizer": "simplex"}, "unknown optimizer 'simplex'"),
+
         ({"output": "thresholds.txt"}, "unsupported file type"),
         ({"output": "no/such/folder/t.json"}, "does not exist"),
         ({"params": OTHER}, "made for other actuator parameters"),
-        ({"monitor": "three-phase"}, "unknown monitor"),
+        ({"calibration": "no-such-calibration.json"}, "no such"),
     ],
 )
 def test_bad_input_is_refused_in_one_line_before_any_work(settings, match, monkeypatch, tmp_path):

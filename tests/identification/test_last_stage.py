@@ -59,7 +59,7 @@ def _oracle(bias_slope: float):
     def residuals_of(fitness):
         def residuals(X):
             currents = np.atleast_2d(X) @ A.T
-            return root_w * (fitness.reference.reference - fitness.reference.filtered(currents))[:, keep]
+            return root_w * (fitness.comparison.reference - fitness.comparison.filtered(currents))[:, keep]
 
         return residuals
 
@@ -148,7 +148,7 @@ def test_a_shifted_fitness_scores_a_corrected_current():
     )
     rng = np.random.default_rng(1)
     current, offset = rng.normal(size=N), rng.normal(size=N)
-    shifted = objective.shifted(objective.reference.filtered(offset))
+    shifted = objective.shifted(objective.comparison.filtered(offset))
     # the filter is linear: scoring I against the reference less F(d) is scoring I + d
     assert shifted(current) == pytest.approx(float(objective(current + offset)), rel=1e-10)
     np.testing.assert_array_equal(shifted.weights, objective.weights)  # the measurement's weights

@@ -164,3 +164,14 @@ def test_a_time_axis_that_does_not_increase_is_refused_everywhere():
     t[100] = t[99]  # a repeated time
     with pytest.raises(InputError, match="sample 100 is at or before"):
         FaultIdentifier(pop_size=8, generations=1).fit(t, trace.i_q)
+
+
+def test_fault_identifier_takes_the_monitor_by_name_or_as_a_model():
+    # docs/conventions.md: `monitor` is which monitor model, by name or as a MonitorEma
+    from emaphm.identification.identifier import FaultIdentifier
+    from emaphm.models import MonitorEma
+
+    assert FaultIdentifier(monitor="paper").settings.monitor == "paper"
+    assert FaultIdentifier(IdentifySettings(monitor="paper")).monitor is None  # built from the name
+    with pytest.raises(InputError, match="monitor 'paper' was asked for, the MonitorEma given is 'default'"):
+        FaultIdentifier(IdentifySettings(monitor="paper"), monitor=MonitorEma())

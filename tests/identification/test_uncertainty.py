@@ -66,7 +66,7 @@ class LinearObjective:
 
     def __init__(self, fitness: Fitness) -> None:
         self.f = fitness
-        self.weights, self.reference = fitness.weights, fitness.reference
+        self.weights, self.comparison = fitness.weights, fitness.comparison
 
     def of_monitor(self, monitor, K, *, duration=None):
         return self.f(monitor.simulate_many(K))
@@ -88,9 +88,9 @@ def test_laplace_intervals_of_a_linear_gaussian_oracle_cover_90_percent():
         measured = u_true @ monitor.G + rng.normal(0.0, 0.05, n)
         fit = Fitness(Comparison.from_signal(t, measured, F_S))
         # the least-squares estimate: weighted regression on the filtered regressors
-        Gf = fit.reference.filtered(monitor.G)
+        Gf = fit.comparison.filtered(monitor.G)
         sw = np.sqrt(fit.weights)
-        u_hat = np.linalg.lstsq((Gf * sw).T, fit.reference.reference * sw, rcond=None)[0]
+        u_hat = np.linalg.lstsq((Gf * sw).T, fit.comparison.reference * sw, rcond=None)[0]
         k_hat = to_faults(u_hat)[0]
         res = laplace(fit, monitor, k_hat)  # type: ignore[arg-type]
         ok = covers(res.ci90_low, res.ci90_high, truth)
@@ -195,7 +195,8 @@ def test_the_packaged_calibration_belongs_to_the_packaged_monitor():
         train = packaged.record["training"]
         assert all(0.85 <= v["coverage"] <= 0.97 for v in train.values())
         assert packaged.record["last_stage"] == stage  # each made for its own last stage
-    assert load_factors() is load_factors(last_stage="switching")  # the default identification's
+    default, switching = load_factors(), load_factors(last_stage="switching")  # the default identification's
+    assert default.record == switching.record and default.scale is switching.scale  # one file, read once
     # the switching stage's estimates are closer to the truth: its intervals are the narrower
     narrow, wide = (
         load_factors(last_stage="switching").record["training"],
@@ -264,11 +265,10 @@ def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_sa
 def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):
     from emaphm.identification import limits
     from emaphm.identification.api import identify
-    from emaphm.identification.uncertainty import mcmc
 
     monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))  # the chain needs a fit, not a converged one
-    monkeypatch.setattr(mcmc, "MAX_STEPS", 60)
-    monkeypatch.setattr(mcmc, "CHUNK", 30)
+    monkeypatch.setattr(limits, "MAX_STEPS", 60)
+    monkeypatch.setattr(limits, "CHUNK", 30)
     steps = []
     # the chain on the monitor's eq. 3, without the switching last stage (not what is checked here)
     res = identify(
@@ -342,3 +342,13 @@ def test_the_sandwich_convolution_is_fftconvolves_same(n, half):
         ]
     )
     np.testing.assert_allclose(got[:: max(1, n // 7)], direct, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+def test_the_packaged_interval_calibration_cannot_be_poisoned_by_a_caller():
+    # review L8: the cached loader handed every caller the same mutable arrays and record
+    first = load_factors()
+    with pytest.raises(ValueError, match="read-only"):
+        first.scale[0] = 99.0
+    first.record["created"] = "changed"
+    again = load_factors()
+    assert again.record["created"] != "changed" and np.all(again.scale < 99.0)

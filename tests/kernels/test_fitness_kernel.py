@@ -138,7 +138,7 @@ def population(n_rows=23, duration=0.2):
 def run_kernel(theta_cmd, rows, fitness):
     out = np.full(rows.shape[0], -1.0)
     f = fitness
-    fitness_lf_many(theta_cmd, rows, f.sos, f.zi, f.padlen, f.reference.reference, f.weights, out)
+    fitness_lf_many(theta_cmd, rows, f.sos, f.zi, f.padlen, f.comparison.reference, f.weights, out)
     return out
 
 

@@ -160,6 +160,11 @@ def coefficient_bounds(params: EmaParams | None = None) -> dict[str, tuple[float
     motor with twice the flux, say, is searched around its own constants, and i_R its ratio to
     the hysteresis band h; the dimensionless shape coefficients and the loop surrogate keep their
     boxes.
+
+    Parameters
+    ----------
+    params : EmaParams, optional
+        The actuator (default: the paper's nominal one).
     """
     ratio = _nameplate_ratios(params)
     return {

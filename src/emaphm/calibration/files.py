@@ -53,14 +53,14 @@ READABLE_VERSIONS = (*OLDER_VERSIONS_LACK, FORMAT_VERSION)
 
 
 def actuator_params(params: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """The parameter groups (`EmaParams.to_dict` form) without the measurement-noise levels."""
+    """The parameter groups `params` (`EmaParams.to_dict` form) without the measurement-noise levels."""
     return {
         group: {k: v for k, v in values.items() if k not in NOT_ACTUATOR} for group, values in params.items()
     }
 
 
 def params_hash(params: EmaParams | dict[str, dict[str, Any]]) -> str:
-    """A 16-hex digest of the actuator parameters (noise levels excluded), stable across runs."""
+    """A 16-hex digest of the actuator `params` (or its `to_dict` form; noise levels excluded), stable."""
     data = params if isinstance(params, dict) else params.to_dict()
     text = json.dumps(actuator_params(data), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -68,7 +68,12 @@ def params_hash(params: EmaParams | dict[str, dict[str, Any]]) -> str:
 
 @dataclass(frozen=True)
 class Calibration:
-    """A calibration: coefficients, the LF step, and the record of how they were obtained."""
+    """A calibration: coefficients, the LF step, and the record of how they were obtained.
+
+    coefficients : Coefficients  the monitor's calibrated constants
+    n_lf : int  LF steps per sample period (1: the LF model steps at T_s = 1/f_s)
+    record : dict  how they were obtained (monitor, scenarios, NRMSE, seed, versions, ...)
+    """
 
     coefficients: Coefficients = field(default_factory=Coefficients)
     n_lf: int = 1  # LF steps per sample period (1: the LF model steps at T_s = 100 µs)
@@ -217,7 +222,7 @@ def _parse(data: Any, where: str) -> Calibration:
 
 
 def load_calibration(path: str | os.PathLike[str]) -> Calibration:
-    """Read a calibration file; a missing, unreadable or inconsistent file raises `InputError`."""
+    """Read the calibration file `path`; a missing, unreadable or inconsistent file raises `InputError`."""
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such calibration file")

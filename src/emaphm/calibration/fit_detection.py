@@ -34,15 +34,16 @@ from numpy.typing import NDArray
 from .._version import __version__
 from .._versions import versions
 from ..actuator import resolve_params
-from ..choices import OPTIMIZERS
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY
 from ..identification.api import identify
 from ..identification.detection import DETECTABLE, detect
 from ..identification.last_stage import resolve_last_stage
+from ..identification.settings import IdentifySettings
 from ..identification.weights import resolve_error_corner
 from ..io import atomic_path, check_output_path
-from ..models import MonitorEma, check_seed
+from ..models import MonitorEma
+from ..models._base import check_seed
 from ..params import EmaParams
 from .files import Calibration, params_hash
 
@@ -68,45 +69,38 @@ def calibrate_detection(
     *,
     params: EmaParams | str | os.PathLike[str] | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
-    monitor: str | None = None,
+    settings: IdentifySettings | None = None,
     runs: int = DETECTION_RUNS,
     threshold_seed: int = THRESHOLD_SEED,
     false_alarm_seed: int = FALSE_ALARM_SEED,
     sensitivity_seed: int | None = SENSITIVITY_SEED,
-    optimizer: str = "ga",
-    pop_size: int | None = None,
-    generations: int | None = None,
-    workers: int | None = None,
-    on_progress: Progress | None = None,
+    progress: Progress | None = None,
     output: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Measure the detection thresholds (about 5 s per identification, 2·`runs` + 14 of them).
 
     `params` is the actuator (`EmaParams` or an actuator file), `calibration` its LF calibration
-    (the packaged one by default, for the nominal actuator only) and `monitor` the monitor model
-    (None: the calibration's). `pop_size`/`generations` set the search's budget (None: identify's
-    defaults for `optimizer`), `workers` its threads. `on_progress(stage, done, total)` is called
-    after each identification. The record (the thresholds file's content) is returned and, with
-    `output`, written there atomically (a ``.json`` file; the package's own is
+    (the packaged one by default, for the nominal actuator only); `settings` how each
+    identification runs (`IdentifySettings`: the monitor, the optimiser, its budget and threads;
+    its seed is replaced by each run's). `runs` healthy runs from `threshold_seed` give the
+    thresholds, as many from `false_alarm_seed` the false alarms, and single faults from
+    `sensitivity_seed` (None: skipped) the sensitivity. `progress` (stage, done, total) is
+    called after each identification. The record (the thresholds file's content) is returned and,
+    with `output`, written there atomically (a ``.json`` file; the package's own is
     ``src/emaphm/data/detection.json``). Bad input raises `InputError` before any work.
     """
     start = time.perf_counter()
-    settings = {
-        "optimizer": optimizer, "pop_size": pop_size, "generations": generations, "runs": runs,
-        "threshold_seed": threshold_seed, "false_alarm_seed": false_alarm_seed,
-        "sensitivity_seed": sensitivity_seed, "workers": workers,
-    }  # fmt: skip
-    actuator, lf = _checked(params, calibration, monitor, settings, output)
-    run = functools.partial(
-        identify, optimizer=optimizer, pop_size=pop_size, generations=generations, workers=workers,
-        calibration=calibration, monitor=monitor, params=actuator, thresholds={},
-    )  # fmt: skip
-    measured = _measure(run, runs, threshold_seed, false_alarm_seed, sensitivity_seed, on_progress)
+    s = settings if settings is not None else IdentifySettings()
+    sets = {"runs": runs, "threshold_seed": threshold_seed, "false_alarm_seed": false_alarm_seed,
+            "sensitivity_seed": sensitivity_seed}  # fmt: skip
+    actuator, lf = _checked(params, calibration, s.monitor, sets, output)
+    run = functools.partial(identify, settings=s, calibration=calibration, params=actuator, thresholds={})
+    measured = _measure(run, runs, threshold_seed, false_alarm_seed, sensitivity_seed, progress)
     record = {
         "thresholds": measured.pop("thresholds"),
         "monitor": lf.monitor,  # identify() warns when another monitor uses these thresholds
         "rule": DETECTION_RULE,
-        "optimizer": optimizer,
+        "optimizer": s.optimizer,
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),  # the eq. 3 weights the runs used
         "threshold_seeds": [threshold_seed, threshold_seed + runs - 1],
         "false_alarm_seeds": [false_alarm_seed, false_alarm_seed + runs - 1],
@@ -122,7 +116,7 @@ def calibrate_detection(
             "created": lf.record.get("created"),
             "params_hash": lf.params_hash,
         },
-        "settings": settings,
+        "settings": {**sets, "identify": s.to_json()},
         "versions": versions(),
     }
     if output is not None:
@@ -136,15 +130,15 @@ def _measure(
     threshold_seed: int,
     false_alarm_seed: int,
     sensitivity_seed: int | None,
-    on_progress: Progress | None,
+    progress: Progress | None,
 ) -> dict[str, Any]:
     """Steps 1-3 of the module's method: the thresholds, the false alarms, the sensitivity."""
-    fit = _healthy_estimates(run, threshold_seed, runs, "healthy runs (thresholds)", on_progress)
+    fit = _healthy_estimates(run, threshold_seed, runs, "healthy runs (thresholds)", progress)
     deviation = np.abs(fit - HEALTHY)[:, [FAULT_NAMES.index(n) for n in DETECTABLE]]
     thresholds = {
         name: round(1.25 * float(deviation[:, j].max()) + 0.005, 4) for j, name in enumerate(DETECTABLE)
     }
-    check = _healthy_estimates(run, false_alarm_seed, runs, "healthy runs (false alarms)", on_progress)
+    check = _healthy_estimates(run, false_alarm_seed, runs, "healthy runs (false alarms)", progress)
     alarms = [detect(k, thresholds) for k in check]
     return {
         "thresholds": thresholds,
@@ -155,7 +149,7 @@ def _measure(
         "healthy_estimates_check_set": check.round(5).tolist(),
         "sensitivity": None
         if sensitivity_seed is None
-        else _sensitivity(run, thresholds, sensitivity_seed, on_progress),
+        else _sensitivity(run, thresholds, sensitivity_seed, progress),
     }
 
 
@@ -178,10 +172,6 @@ def _checked(
             f"the false-alarm runs must be fresh: seeds {second}..{second + runs - 1} overlap the "
             f"threshold runs' {first}..{first + runs - 1}"
         )
-    if settings["optimizer"] not in OPTIMIZERS:
-        raise InputError(
-            f"unknown optimizer {settings['optimizer']!r}; choose one of {', '.join(OPTIMIZERS)}"
-        )
     if output is not None:
         check_output_path(output, suffixes=(".json",), option="output")
     actuator = resolve_params(params)
@@ -190,19 +180,19 @@ def _checked(
 
 
 def _healthy_estimates(
-    run: Identify, first_seed: int, runs: int, stage: str, on_progress: Progress | None
+    run: Identify, first_seed: int, runs: int, stage: str, progress: Progress | None
 ) -> NDArray[np.float64]:
     """The estimates of `runs` healthy identifications (noise on), seeds `first_seed`.. (one row each)."""
     out = []
     for j, seed in enumerate(range(first_seed, first_seed + runs)):
         out.append(run(HEALTHY, seed=seed).estimate)
-        if on_progress is not None:
-            on_progress(stage, j + 1, runs)
+        if progress is not None:
+            progress(stage, j + 1, runs)
     return np.array(out)
 
 
 def _sensitivity(
-    run: Identify, thresholds: dict[str, float], seed: int, on_progress: Progress | None
+    run: Identify, thresholds: dict[str, float], seed: int, progress: Progress | None
 ) -> list[dict[str, Any]]:
     """Single faults of 0.1 and 0.2 (k8: 0.6, 0.7; eccentricity at phase 0.3), one run each: detected?"""
     out: list[dict[str, Any]] = []
@@ -215,8 +205,8 @@ def _sensitivity(
                 k[6] = 0.3
             found = detect(run(k, seed=seed).estimate, thresholds)
             out.append({"fault": name, "value": float(k[i]), "detected": found})
-            if on_progress is not None:
-                on_progress("sensitivity (single faults)", len(out), 2 * len(DETECTABLE))
+            if progress is not None:
+                progress("sensitivity (single faults)", len(out), 2 * len(DETECTABLE))
     return out
 
 

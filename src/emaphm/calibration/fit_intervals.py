@@ -30,7 +30,8 @@ from ..actuator import resolve_params
 from ..errors import InputError
 from ..faults import random_faults
 from ..identification.uncertainty import FIT_COVERAGE, Factors, fit_factors
-from ..models import MonitorEma, check_seed
+from ..models import MonitorEma
+from ..models._base import check_seed
 from ..params import EmaParams
 from .files import Calibration
 
@@ -57,7 +58,25 @@ def collect_cases(
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
     "raw_std"} arrays (one row per case). The draws do not depend on `cases`, so a longer set
-    extends a shorter one, and `first` resumes one."""
+    extends a shorter one, and `first` resumes one.
+
+    Parameters
+    ----------
+    cases, seed : int
+        The number of cases and the seed of their draws.
+    calibration : Calibration or path, optional
+        The LF calibration (default: the packaged one).
+    monitor : {"default", "paper"}, optional
+        The monitor model (None: the calibration's).
+    absent : float
+        Probability that each fault of a case is absent (healthy value), in [0, 1].
+    first : int
+        The first case to identify (to resume a set).
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each case.
+    params : EmaParams, optional
+        The actuator (default: the paper's nominal one).
+    """
     from ..identification.api import identify
 
     K = random_faults(cases, seed, absent=absent)[first:]
@@ -90,6 +109,21 @@ def calibrate_uq(
     """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
 
     `params` is the actuator (`EmaParams` or an actuator file): `calibration` must be its own.
+
+    Parameters
+    ----------
+    cases : int
+        Random HF actuators identified.
+    seed : int
+        Seed of the cases' draws (case i is identified with seed 1000·seed + i).
+    calibration : Calibration or path, optional
+        The actuator's LF calibration (default: the packaged one).
+    monitor : {"default", "paper"}, optional
+        The monitor model (None: the calibration's).
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each case.
+    params : EmaParams or path, optional
+        The actuator (default: the paper's nominal one).
     """
     from ..identification.last_stage import resolve_last_stage
     from ..identification.weights import resolve_error_corner
@@ -112,7 +146,7 @@ def calibrate_uq(
             "created": lf.record.get("created"),
             "params_hash": lf.params_hash,
         },
-        # the eq. 3 frequency weights the identifications used (`fitness.error_weights`)
+        # the eq. 3 frequency weights the identifications used (`weights.error_weights`)
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),
         # the last stage the identifications ran (`switching`): it sets how far estimates fall
         # from the truth, so intervals fitted with one do not hold for the other

@@ -31,7 +31,7 @@ from ..commands import Command, command_record
 from ..errors import InputError
 from ..identification.optimizers import BatchProblem, minimize_batch
 from ..identification.signals import CUTOFF_HZ, FILTER_ORDER, Comparison
-from ..models import check_seed
+from ..models._base import check_seed
 from ..params import EmaParams
 from .coefficients import SURROGATE, Coefficients, checked_free, coefficient_bounds
 from .files import Calibration, check_monitor, held_coefficients
@@ -85,6 +85,25 @@ def calibrate(
     Without `free` every coefficient is fitted from the first guess and `start` must not be
     given. Re-fitting a subset measures what one change of the monitor does without moving every
     coefficient with the GA's own spread.
+
+    Parameters
+    ----------
+    monitor : {"default", "paper"}
+        The monitor model to calibrate (above).
+    seed : int
+        Seed of the GA and of the noisy held-out check.
+    pop_size, generations : int
+        The GA's population and number of generations.
+    n_lf : int
+        LF steps per sample period (1: the LF model steps at the sample time T_s).
+    params : EmaParams, optional
+        The actuator (default: the paper's nominal one).
+    fit, check : sequence of Scenario, optional
+        The fitting and held-out scenarios (default: those of `monitor`).
+    progress : callable, optional
+        ``progress(stage, done, total)``, called as the references run and the GA advances.
+    commands, free, start
+        See above.
     """
     task = _task(monitor, seed, pop_size, generations, n_lf, params, fit, check, commands, free, start)
     began = time.perf_counter()

@@ -19,7 +19,8 @@ from ..commands import Chirp, ChirpHold, Command, Steps
 from ..faults import HEALTHY, as_fault_vector, random_faults
 from ..identification.signals import Comparison
 from ..kernels.monitor import simulate_lf_many
-from ..models import HighFidelityEma, monitor_rows
+from ..models import HighFidelityEma
+from ..models.lf import monitor_rows
 from ..params import EmaParams
 from .coefficients import Coefficients
 
@@ -51,7 +52,12 @@ CALIBRATION_COMMANDS: dict[str, Command] = {
 @dataclass(frozen=True)
 class Scenario:
     """A named fault vector the HF twin is run with, under the command named `command` (a key of
-    the `commands` given to `calibrate`, `CALIBRATION_COMMANDS` by default)."""
+    the `commands` given to `calibrate`, `CALIBRATION_COMMANDS` by default).
+
+    name : str  the scenario's name in the calibration record
+    faults : tuple of 8 floats in [0, 1]  the fault vector k1..k8
+    command : str  the name of its command
+    """
 
     name: str
     faults: tuple[float, ...]
@@ -154,7 +160,23 @@ def hf_references(
     commands: Mapping[str, Command] = CALIBRATION_COMMANDS,
 ) -> list[Comparison]:
     """Filtered HF i_q of each scenario on the sample grid of its command (the runs of one
-    command side by side, `HighFidelityEma.simulate_batch`)."""
+    command side by side, `HighFidelityEma.simulate_batch`).
+
+    Parameters
+    ----------
+    scenarios : sequence of Scenario
+        The fault vectors and the commands they run under.
+    params : EmaParams
+        The actuator.
+    noise : bool
+        Add the seeded measurement noise.
+    seed : int
+        Seed of the noise.
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each command's batch.
+    commands : mapping of str to Command
+        The commands the scenarios name (`CALIBRATION_COMMANDS` by default).
+    """
     out: dict[int, Comparison] = {}
     for command in dict.fromkeys(sc.command for sc in scenarios):
         js = [j for j, sc in enumerate(scenarios) if sc.command == command]
@@ -185,6 +207,23 @@ def scenario_nrmse(
 
     The runs of one command are rows of one population-kernel call; `monitor` sets the
     structure (`models.monitor_rows`).
+
+    Parameters
+    ----------
+    coefficients : sequence of Coefficients
+        The coefficient sets to score.
+    scenarios : sequence of Scenario
+        The fault vectors and their commands.
+    references : sequence of Comparison
+        The filtered HF i_q of each scenario (`hf_references`).
+    params : EmaParams
+        The actuator.
+    n_lf : int
+        LF steps per sample period.
+    commands : mapping of str to Command
+        The commands the scenarios name (`CALIBRATION_COMMANDS` by default).
+    monitor : {"default", "paper"}
+        The monitor model's structure.
     """
     n_c = len(coefficients)
     out = np.empty((n_c, len(scenarios)))

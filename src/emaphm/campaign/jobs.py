@@ -49,7 +49,13 @@ def _now() -> str:
 
 
 def run_job(job: dict[str, Any]) -> dict[str, Any]:
-    """Run one job and return its results row (`store.RESULT_COLUMNS` plus campaign and actuator)."""
+    """Run one job and return its results row (`store.RESULT_COLUMNS` plus campaign and actuator).
+
+    Parameters
+    ----------
+    job : dict
+        One job in `Job.to_dict` form (plain data, so that any worker can run it).
+    """
     from ..identification.api import identify
     from ..identification.result import stage_record
 

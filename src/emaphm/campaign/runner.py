@@ -39,7 +39,10 @@ Progress = Callable[[int, int, int, float], None]  # done, failed, to do, elapse
 
 @dataclass(frozen=True)
 class CampaignSummary:
-    """What a run did."""
+    """What a run did: `campaign` (its name), `jobs` (in the spec), `already_done` (in the store
+    before), `submitted`, `done`, `failed` (this run's), `wall_time_s` and `startup_s` (the wall time,
+    and the cluster's start and compile-cache warm-up before the first job [s]), `backend` (where
+    the jobs ran) and `workers` (how many ran at once)."""
 
     campaign: str
     jobs: int
@@ -50,7 +53,6 @@ class CampaignSummary:
     wall_time_s: float
     backend: str
     workers: int
-    # of the wall time, the start of the cluster (and the compile-cache warm-up) before the first job
     startup_s: float = 0.0
 
     def to_json(self) -> dict[str, Any]:
@@ -85,7 +87,10 @@ def run_campaign(
     flush_rows: int = 20,
     flush_seconds: float = 10.0,
 ) -> CampaignSummary:
-    """Run the jobs of `spec` that `out` does not hold yet; see the module docstring."""
+    """Run the jobs of `spec` (a `CampaignSpec` or its file) that the results store `out` (a directory)
+    does not hold yet (module docstring). `scheduler`: a Dask scheduler's address or "serial" (None:
+    ``DASK_SCHEDULER_ADDRESS``, else a local cluster of `workers` processes, one per core if None);
+    `progress` (done, failed, to_do, elapsed_s); rows are written each `flush_rows` or `flush_seconds` [s]."""
     spec = _spec(spec)
     store = ResultStore(out)
     jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work

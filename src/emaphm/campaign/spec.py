@@ -99,7 +99,15 @@ def history_seed(seed: int, flight: int) -> int:
 
 @dataclass(frozen=True)
 class Job:
-    """One identification of a campaign (JSON-ready through `to_dict`, for workers)."""
+    """One identification of a campaign (JSON-ready through `to_dict`, for workers).
+
+    campaign, actuator : str  the campaign's name and the actuator's id
+    flight : int  the flight number (0: a one-off measurement)
+    seed : int  the job's seed in the campaign; identify_seed : int  the seed identify runs with
+    truth : tuple of 8 floats or None  the twin's fault vector (None: a recording is read)
+    reference, reference_sha256, channel_map : str or None  the recording, its digest, its channel map
+    settings : dict  `identify`'s settings; key : str  the job's content key in the store
+    """
 
     campaign: str
     actuator: str
@@ -124,7 +132,14 @@ class Job:
 
 @dataclass(frozen=True)
 class CampaignSpec:
-    """A validated campaign file (`load_campaign`)."""
+    """A validated campaign file (`load_campaign`).
+
+    name : str  the campaign's name; description : str  its free text
+    seeds : tuple of int  the seeds each flight is identified with
+    settings : dict  `identify`'s settings for every job (``[identify]``)
+    actuators : tuple  the actuators and their flights (``[[actuator]]``, ``[[fleet]]``)
+    source : str  the file it was read from
+    """
 
     name: str
     seeds: tuple[int, ...]
@@ -225,7 +240,13 @@ def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
 
 
 def load_campaign(path: str | os.PathLike[str]) -> CampaignSpec:
-    """Read and validate a campaign file; `InputError` (one line, naming the key) for any mistake."""
+    """Read and validate a campaign file; `InputError` (one line, naming the key) for any mistake.
+
+    Parameters
+    ----------
+    path : str or path
+        The campaign file (TOML; docs/campaigns.md).
+    """
     p = Path(path)
     where = str(p)
     data = read_toml(p, "campaign file")

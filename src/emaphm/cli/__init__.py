@@ -12,7 +12,7 @@ One module per group of commands, registered below in the order ``emaphm --help`
 
 - `simulate`: ``simulate``, ``demo``
 - `identify`: ``identify``
-- `calibrate`: ``calibrate``, ``calibrate-uq``
+- `calibrate`: ``calibrate``, ``calibrate-uq``, ``calibrate-detection``
 - `data`: ``convert``, ``inspect``
 - `actuator`: ``params``, ``thresholds``
 - `prognostics`: ``rul``
@@ -64,6 +64,7 @@ app.command()(simulate.simulate)
 app.command()(identify.identify)
 app.command()(calibrate.calibrate)
 app.command("calibrate-uq")(calibrate.calibrate_uq)
+app.command("calibrate-detection")(calibrate.calibrate_detection)
 app.command()(data.convert)
 app.command("inspect")(data.inspect_command)
 app.command()(simulate.demo)

@@ -1,4 +1,5 @@
-"""`emaphm calibrate` (the monitor's coefficients) and `emaphm calibrate-uq` (the intervals' factors)."""
+"""`emaphm calibrate` (the monitor's coefficients), `emaphm calibrate-uq` (the intervals' factors) and
+`emaphm calibrate-detection` (the detection thresholds)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from .options import (
 )
 from .output import err, progress
 
-__all__ = ["calibrate", "calibrate_uq"]
+__all__ = ["calibrate", "calibrate_detection", "calibrate_uq"]
 
 
 def calibrate(
@@ -51,7 +52,7 @@ def calibrate(
     from ..calibration import load_calibration
     from ..calibration.fit_monitor import calibrate as run_calibration
     from ..io import check_output_path
-    from ..models import check_seed
+    from ..models._base import check_seed
 
     check_seed(seed)
     check_output_path(output, suffixes=(".json",), inputs=(params, start))
@@ -91,7 +92,8 @@ def calibrate_uq(
     from ..actuator import resolve_params
     from ..calibration.fit_intervals import calibrate_uq as run_calibrate_uq
     from ..io import check_output_path
-    from ..models import MonitorEma, check_seed
+    from ..models import MonitorEma
+    from ..models._base import check_seed
 
     check_seed(seed)
     if cases < 20:
@@ -114,3 +116,46 @@ def calibrate_uq(
     for name, fit in factors.record["training"].items():
         err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
     err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")
+
+
+def calibrate_detection(
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Detection thresholds file to write (JSON).")
+    ] = Path("detection.json"),
+    runs: Annotated[
+        int, typer.Option(help="Healthy identifications for the thresholds, and as many to count false alarms.")
+    ] = 20,
+    seed: Annotated[int, typer.Option(help="Seed of the first healthy run (the false alarms' start 1000 later).")] = 1000,
+    sensitivity: Annotated[
+        bool, typer.Option("--sensitivity/--no-sensitivity", help="Also check that each single fault of 0.1 is detected.")
+    ] = True,
+    calibration: CalibrationOption = None,
+    monitor: MonitorOption = None,
+    workers: WorkersOption = 0,
+    params: ParamsNeedCalibrationOption = None,
+) -> None:
+    """Measure the detection thresholds on healthy runs of the HF twin (after 'emaphm calibrate')."""
+    from ..calibration.fit_detection import calibrate_detection as run_calibrate_detection
+    from ..identification.settings import IdentifySettings
+    from ..io import check_output_path
+
+    check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
+    settings = IdentifySettings(monitor=monitor, workers=workers)  # the rest as identify's defaults
+    with progress() as update:
+
+        def report(stage: str, done: int, total: int) -> None:
+            update(stage, done, total)
+            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
+                err.print(f"{done}/{total} {stage}")
+
+        record = run_calibrate_detection(
+            params=params, calibration=calibration, settings=settings, runs=runs, threshold_seed=seed,
+            false_alarm_seed=seed + 1000, sensitivity_seed=seed + 2000 if sensitivity else None,
+            progress=report, output=output,
+        )  # fmt: skip
+    for name, value in record["thresholds"].items():
+        err.print(f"{name}: threshold {value:g}")
+    err.print(
+        f"false alarms: {record['false_alarm_runs']} of {record['runs']} fresh healthy runs; "
+        f"wrote {output} ({record['wall_time_s']:.0f} s)"
+    )

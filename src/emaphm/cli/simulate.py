@@ -50,7 +50,8 @@ def simulate(
     from ..commands import make_command
     from ..faults import describe, parse_faults
     from ..io import TRACE_SUFFIXES, check_output_path, write_trace
-    from ..models import check_seed, make_model
+    from ..models import make_model
+    from ..models._base import check_seed
 
     k = parse_faults(faults)
     check_seed(seed)
@@ -79,8 +80,9 @@ def demo(
 ) -> None:
     """The main job: the paper's Table 1 experiment (HF twin with noise, five identifications)."""
     from ..demo import run_demo
+    from .options import settings_from_options
 
     run_demo(
-        output_dir, seed=seed, optimizer=optimizer, runs=runs, calibration=calibration, monitor=monitor,
-        console=stdout_console(), status=status, params=params,
+        output_dir, seed=seed, runs=runs, settings=settings_from_options({"optimizer": optimizer, "monitor": monitor}),
+        calibration=calibration, console=stdout_console(), status=status, params=params,
     )  # fmt: skip

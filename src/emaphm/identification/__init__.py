@@ -32,17 +32,21 @@ __all__ = [
     "FaultIdentifier",
     "IdentificationResult",
     "IdentifySettings",
+    "Uncertainty",
     "absolute_errors",
+    "detect",
     "identify",
     "lowpass",
     "nrmse",
     "percent_error",
+    "verdicts",
 ]
 
 _WHERE = {
     "CUTOFF_HZ": "signals", "Comparison": "signals", "lowpass": "signals", "nrmse": "signals",
     "absolute_errors": "metrics", "percent_error": "metrics", "FaultIdentifier": "identifier",
     "IdentificationResult": "result", "IdentifySettings": "settings", "identify": "api",
+    "detect": "detection", "Uncertainty": "uncertainty", "verdicts": "uncertainty",
 }  # fmt: skip
 
 

@@ -71,7 +71,7 @@ class Context:
         fitness = self.objective if objective is None else objective
         keep = np.flatnonzero(fitness.weights > 0)
         root_w = np.sqrt(fitness.weights[keep])
-        reference = fitness.reference.reference[keep]
+        reference = fitness.comparison.reference[keep]
 
         def residuals(X: NDArray[np.float64]) -> NDArray[np.float64]:
             currents = self.monitor.simulate_many(search_to_faults(X), duration=self.duration, check=False)
@@ -160,7 +160,7 @@ def prepare(
     """Check the measurement i_q [A] at t [s] (under `command`, default the monitor's; `theta_u`
     [rad], the surface position if measured, tells the rests in holds) and set up the comparison."""
     t, i_q = _checked(t, i_q)
-    base = monitor if monitor is not None else MonitorEma()
+    base = monitor if monitor is not None else MonitorEma(monitor=settings.monitor)
     model = MonitorEma(
         base.params, command if command is not None else base.command, base.calibration, allow_mismatch=True
     )  # fmt: skip  (base was checked when it was built)

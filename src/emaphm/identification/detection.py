@@ -81,7 +81,16 @@ def _read_only(value: Any) -> Any:
 
 
 def detect(estimate: ArrayLike, thresholds: Mapping[str, float] | None = None) -> list[str]:
-    """Names of the faults whose identified value exceeds its threshold above healthy."""
+    """Names of the faults whose identified value exceeds its threshold above healthy.
+
+    Parameters
+    ----------
+    estimate : array_like of 8 floats in [0, 1]
+        The identified fault vector k1..k8.
+    thresholds : mapping of str to float, optional
+        Fault name -> threshold, in fault units above healthy ({}: nothing is detected; default:
+        the shipped ones, ``data/detection.json``).
+    """
     k = as_fault_vector(estimate, name="estimate")
     limits = thresholds if thresholds is not None else load_thresholds()["thresholds"]
     deviation = np.abs(k - HEALTHY)

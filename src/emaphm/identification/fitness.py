@@ -38,7 +38,8 @@ SLOPE_UNITS = {"s": 1.0, "ms": 1e-3}  # the slope in A per this unit of time
 
 
 class Fitness:
-    """eq. (3) against one reference: call it on LF currents (shape (n,) or (m, n)) for err [A²].
+    """eq. (3) against one reference, `comparison` (the filtered measured current on the monitor's grid):
+    call it on LF currents (shape (n,) or (m, n)) for err [A²].
 
     `mask` (0/1 per sample, e.g. `moving_mask`) leaves samples out of the sum; `emphasis` (≥ 0
     per sample, e.g. `error_weights`) scales each sample's weight.
@@ -46,16 +47,16 @@ class Fitness:
 
     def __init__(
         self,
-        reference: Comparison,
+        comparison: Comparison,
         slope_unit: str = "s",
         mask: ArrayLike | None = None,
         emphasis: ArrayLike | None = None,
     ) -> None:
         if slope_unit not in SLOPE_UNITS:
             raise InputError(f"unknown slope unit {slope_unit!r}; use one of {', '.join(SLOPE_UNITS)}")
-        self.reference = reference
+        self.comparison = comparison
         self.slope_unit = slope_unit
-        slope = np.gradient(reference.reference, reference.t) * SLOPE_UNITS[slope_unit]
+        slope = np.gradient(comparison.reference, comparison.t) * SLOPE_UNITS[slope_unit]
         self.weights: NDArray[np.float64] = 1.0 / np.sqrt(slope**2 + 1.0)
         if mask is not None:  # samples left out of the sum (`moving_mask`)
             m = np.asarray(mask, dtype=np.float64)
@@ -70,7 +71,7 @@ class Fitness:
                 raise ValueError("emphasis must be finite and >= 0")
             self.weights = self.weights * e
         # the comparison filter (`signals.lowpass`) for the fused kernel: sosfiltfilt's defaults
-        self.sos, self.zi, self.padlen = comparison_filter(reference.f_s)
+        self.sos, self.zi, self.padlen = comparison_filter(comparison.f_s)
 
     def shifted(self, offset: ArrayLike) -> Fitness:
         """The same eq. 3 (weights, mask, filter) against the reference less `offset` [A] per
@@ -80,11 +81,11 @@ class Fitness:
         if d.shape != self.weights.shape:
             raise ValueError(f"offset has shape {d.shape}, the reference {self.weights.shape}")
         out = copy.copy(self)
-        out.reference = replace(self.reference, reference=self.reference.reference - d)
+        out.comparison = replace(self.comparison, reference=self.comparison.reference - d)
         return out
 
     def __call__(self, currents: ArrayLike) -> NDArray[np.float64]:
-        residual = self.reference.reference - self.reference.filtered(currents)
+        residual = self.comparison.reference - self.comparison.filtered(currents)
         return np.sum(self.weights * residual**2, axis=-1)  # type: ignore[no-any-return]
 
     def of_monitor(
@@ -99,7 +100,7 @@ class Fitness:
         """
         _, theta_cmd = monitor.sample_grid(duration)
         rows = monitor.rows(K)
-        ref = self.reference.reference
+        ref = self.comparison.reference
         if len(theta_cmd) != len(ref):
             raise ValueError(f"the monitor's grid has {len(theta_cmd)} samples, the reference {len(ref)}")
         if len(ref) <= self.padlen:

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..commands import Command
+from ..errors import InputError
 from ..faults import as_fault_vector
 from ..models import MonitorEma
 from . import search
@@ -44,8 +45,9 @@ class FaultIdentifier:
     ----------
     settings : IdentifySettings, optional
         How it runs; its ``seed`` is the optimiser's. Keywords (`options`) override its fields.
-    monitor : MonitorEma, optional
-        The calibrated monitor model (its command is replaced by the measurement's).
+    monitor : MonitorEma or {"default", "paper"}, optional
+        The calibrated monitor model (its command is replaced by the measurement's), or its name:
+        the settings' ``monitor``, for the packaged calibration (None: the settings').
     on_generation : callable(gen, max_gen, best), optional
         Progress callback.
 
@@ -63,11 +65,17 @@ class FaultIdentifier:
         self,
         settings: IdentifySettings | None = None,
         *,
-        monitor: MonitorEma | None = None,
+        monitor: MonitorEma | str | None = None,
         on_generation: OnGeneration | None = None,
         **options: Any,
     ) -> None:
+        if isinstance(monitor, str):  # the monitor by name: the settings' field (docs/conventions.md)
+            options, monitor = {**options, "monitor": monitor}, None
         self.settings = IdentifySettings.resolve(settings, options)
+        if monitor is not None and self.settings.monitor not in (None, monitor.monitor):
+            raise InputError(
+                f"monitor {self.settings.monitor!r} was asked for, the MonitorEma given is {monitor.monitor!r}"
+            )
         self.monitor = monitor
         self.on_generation = on_generation
 

@@ -4,7 +4,7 @@ The averaged monitor errs at the truth like a twin with a 1 % torque error (LF-v
 1.8 %, 7 in 1000 random cases above 4 %; docs/theory/monitor-model.md §4), and that bias, not the
 search, makes most of an estimate's error. A switching model, the mean of the twin's hysteresis
 drive at three other integration steps, follows the twin to 1.05 % median and 2.74 % at worst
-over 1000 random cases (`benchmarks/tail_conditioning.py --switching`), but one evaluation costs
+over 1000 random cases (`studies/tail_conditioning.py --switching`), but one evaluation costs
 ≈ 50 ms of one thread, ~100 monitor runs: a search on it does not fit the time budget. So the
 search stays on the monitor and this stage corrects it where the estimate is, by output space
 mapping:
@@ -19,8 +19,8 @@ where it changes slowly with k, the fixed point is where the switching model fit
 with the monitor's sensitivities (where those mislead, the fixed point is elsewhere: docs/
 identification.md §6). Averaging d over the iterations (and I_S over the steps) keeps
 the chaotic stick–slip realisation of any one run out of the correction: a polish on one
-discretisation's current fitted that realisation instead of the faults (BENCHMARKS.md, "A
-switching last stage, measured and not built").
+discretisation's current fitted that realisation instead of the faults (benchmarks/results/
+HISTORY.md, "A switching last stage, measured and not built").
 
 Each iteration costs one switching evaluation (one twin run per step, side by side on threads)
 and one least-squares polish of the monitor; `limits.SWITCHING_ITERATIONS` of them, after one at the
@@ -211,10 +211,10 @@ def space_mapping(
     current, f = switching_fit(x)
     # each iterate: its point, the switching model's current and eq. 3 there, the corrected eq. 3
     iterates = [(x, current, f, objective)]
-    d_mean, evaluations, stopped = np.zeros_like(objective.reference.reference), 0, "all iterations run"
+    d_mean, evaluations, stopped = np.zeros_like(objective.comparison.reference), 0, "all iterations run"
     for j in range(iterations):
         try:
-            d = objective.reference.filtered(current - monitor_current(to_faults(x[None, :])[0]))
+            d = objective.comparison.filtered(current - monitor_current(to_faults(x[None, :])[0]))
         except SimulationError:
             stopped = f"the monitor diverged at iterate {j}"
             break
@@ -239,8 +239,8 @@ def space_mapping(
     history = [it[2] for it in iterates]
     best = int(np.argmin(np.asarray(history) + smooth))
     x, current, fitness, corrected = iterates[best]
-    keep = objective.weights > 0
-    fit_nrmse = float(nrmse(objective.reference.reference[keep], objective.reference.filtered(current)[keep]))
+    keep, measured = objective.weights > 0, objective.comparison
+    fit_nrmse = float(nrmse(measured.reference[keep], measured.filtered(current)[keep]))
     return SwitchingStage(x, corrected, current, fitness, fit_nrmse, history[0], best, evaluations, history,
                           [float(v) for v in smooth], stopped, [it[0] for it in iterates])  # fmt: skip
 

@@ -34,7 +34,18 @@ __all__ = ["absolute_errors", "percent_error", "wrap_phase"]
 def percent_error(
     estimate: ArrayLike, truth: ArrayLike, *, form: Literal["table1", "printed"] = "table1"
 ) -> float:
-    """%err of an identified fault vector against the true one (both 8 values in [0, 1])."""
+    """%err of an identified fault vector against the true one (both 8 values in [0, 1]).
+
+    Parameters
+    ----------
+    estimate : array_like of 8 floats in [0, 1]
+        The identified fault vector k1..k8.
+    truth : array_like of 8 floats in [0, 1]
+        The true fault vector.
+    form : {"table1", "printed"}
+        "table1": the reading of eq. 4 that reproduces the paper's Table 1; "printed": eq. 4 as
+        printed (docs/identification.md says why they differ).
+    """
     k = as_fault_vector(estimate, name="estimate")
     kt = as_fault_vector(truth, name="truth")
     d = k - kt
@@ -58,7 +69,15 @@ def wrap_phase(dk7: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
 
 
 def absolute_errors(estimate: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:
-    """|k_i − k̄_i| per fault (k7's difference taken on the circle: the phase wraps at 1)."""
+    """|k_i − k̄_i| per fault (k7's difference taken on the circle: the phase wraps at 1).
+
+    Parameters
+    ----------
+    estimate : array_like of 8 floats in [0, 1]
+        The identified fault vector k1..k8.
+    truth : array_like of 8 floats in [0, 1]
+        The true fault vector.
+    """
     d = np.abs(as_fault_vector(estimate, name="estimate") - as_fault_vector(truth, name="truth"))
     d[6] = abs(wrap_phase(d[6]))
     return d

@@ -33,7 +33,25 @@ def stage_record(settings: dict[str, Any], name: str) -> dict[str, Any] | None:
 
 @dataclass(frozen=True)
 class IdentificationResult:
-    """One identification: the estimate and everything needed to reproduce and judge it."""
+    """One identification: the estimate and everything needed to reproduce and judge it.
+
+    estimate : ndarray of 8 floats in [0, 1]  the identified fault vector k1..k8
+    fitness : float  eq. (3) at the estimate [A²]
+    evaluations : int  LF model evaluations of all the stages
+    wall_time_s : float  the identification's wall time [s]
+    seed : int  the seed given (split into the twin's noise seed and the optimiser's)
+    optimizer : str  the global search (`IdentifySettings.optimizer`)
+    truth : ndarray or None  the fault vector the twin ran with (None for a recording)
+    detected : list of str  the faults reported present (none when the fit fails)
+    history : list of float  the search's best eq. (3) per generation [A²]
+    settings : dict  the record: settings, limits, stage records, inputs and versions (`stage`)
+    version : str  emaphm's version
+    warnings : list of str  what makes the result doubtful, one sentence each
+    fit_nrmse : float or None  NRMSE of the fitted current against the measured one [-]
+    uncertainty : Uncertainty or None  the 90 % intervals (None with ``uncertainty="none"``)
+    fault_verdicts : dict or None  "present", "absent" or "cannot tell" per detectable fault
+    curves : dict of ndarray or None  t, measured, fitted, compared on the model grid (not in the JSON)
+    """
 
     estimate: NDArray[np.float64]
     fitness: float

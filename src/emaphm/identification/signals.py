@@ -105,7 +105,19 @@ def sosfiltfilt_padlen(sos: NDArray[np.float64]) -> int:
 
 def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = -1) -> NDArray[np.float64]:
     """Zero-phase Butterworth low-pass (order 2, forward–backward) along `axis`: the numbers of
-    ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``."""
+    ``sosfiltfilt(butter(2, cutoff, fs=f_s, output="sos"), x, axis=axis)``.
+
+    Parameters
+    ----------
+    x : array_like
+        The signal(s), sampled at `f_s`.
+    f_s : float
+        Sample rate [Hz].
+    cutoff : float
+        Cut-off frequency [Hz].
+    axis : int
+        The time axis of `x`.
+    """
     sos, zi, pad = comparison_filter(f_s, cutoff)
     a = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
     n = a.shape[-1]
@@ -121,7 +133,17 @@ def lowpass(x: ArrayLike, f_s: float, *, cutoff: float = CUTOFF_HZ, axis: int = 
 
 
 def nrmse(reference: ArrayLike, estimate: ArrayLike, *, axis: int = -1) -> NDArray[np.float64] | float:
-    """‖ref − est‖ ⁄ ‖ref − mean(ref)‖ along `axis` (inputs already filtered and on one grid)."""
+    """‖ref − est‖ ⁄ ‖ref − mean(ref)‖ along `axis` (inputs already filtered and on one grid).
+
+    Parameters
+    ----------
+    reference : array_like
+        The reference signal (the measured or HF current) [A].
+    estimate : array_like
+        The model's signal on the same grid [A].
+    axis : int
+        The time axis.
+    """
     ref = np.asarray(reference, dtype=np.float64)
     est = np.asarray(estimate, dtype=np.float64)
     scale = np.linalg.norm(ref - ref.mean(axis=axis, keepdims=True), axis=axis)
@@ -142,7 +164,7 @@ def resample(t_src: ArrayLike, x_src: ArrayLike, t_grid: ArrayLike, f_s: float) 
     A source sampled faster than the grid (by more than `ANTI_ALIAS_ABOVE`, on a uniform grid) is
     first low-passed on its own grid (zero-phase Butterworth, order 8, at 0.4·f_s): interpolating
     first would fold the inverter's ripple above the grid's Nyquist rate into the comparison band
-    (issue 10; `benchmarks/bench_resample.py` measures it). A source at the grid's rate or
+    (issue 10; `studies/bench_resample.py` measured it). A source at the grid's rate or
     slower is interpolated as it is, so a trace on the model grid comes through unchanged.
     """
     t_src = np.asarray(t_src, dtype=np.float64)

@@ -17,6 +17,17 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import maximum_filter1d
 
 from ..errors import InputError
+from .limits import (
+    BAND_HZ,
+    ERROR_CORNER_HZ,
+    ERROR_MEMORY_S,
+    HOLD_SETTLE_S,
+    LONG_HOLD_S,
+    PARK_SETTLE_S,
+    REST_BAND,
+    REST_SETTLE_S,
+    REVERSAL_FRACTION,
+)
 from .settings import parse_error_corner
 
 __all__ = [
@@ -36,27 +47,10 @@ __all__ = [
     "resolve_error_corner",
 ]
 
-# in a short hold (a staircase's dwell), a rest of the surface counts after this long [s]
-HOLD_SETTLE_S = 0.05
 
-# a hold longer than this [s] in all is a park (`moving_mask`), not a staircase's dwell
-LONG_HOLD_S = 0.5
 
-# such a hold (a park) is left out from this long after the command stops [s], whatever the surface
-# does (`moving_mask`): on the chirp followed by a hold, 8 random cases x 2 seeds, %err median / p90 /
-# max 4.62 / 7.20 / 9.57 with the rests only, after `HOLD_SETTLE_S`, and 2.77 / 5.30 / 6.12 with the
-# rests after 20 ms; but on 40 cases the slips kept in the parks drove 9 of 80 runs above 10 %err
-# (BENCHMARKS.md). A staircase's 0.2 s dwells keep `HOLD_SETTLE_S`: its rests after a step carry the
-# breakaway friction, and a 10 or 20 ms window there made one of 12 runs 13-18 %err
-PARK_SETTLE_S = 0.02
 
-# in a hold, a rest of the surface whose measured current is below the monitor's ring edge
-# (`moving_mask`) counts after this long [s]: the loop's switching state decides that current
-REST_SETTLE_S = 0.005
 
-# the surface counts as at rest while its measured position stays within this band [rad]: 10 LSB
-# of the 16-bit ±0.3 rad position sensor, 10 σ of its noise (DESIGN §7)
-REST_BAND = 1e-4
 
 
 def _trailing_spread(pos: NDArray[np.float64], window: int) -> NDArray[np.float64]:
@@ -134,34 +128,9 @@ def moving_mask(
     return np.where(held, 0.0, 1.0)
 
 
-# the fastest command the monitor is compared on [Hz]: the FDI chirp's top frequency (DESIGN §6),
-# the fastest motion the monitor was fitted on. Above it the monitor is far from the twin: on the
-# chirp run on to 19.5 Hz its error at the true faults (150 Hz filtered, per quarter second, 12
-# random cases, `benchmarks/monitor_error_at_truth.py --command chirp-2s`) grows from 4-9 mA below
-# 5 Hz to 10-25 mA above 10 Hz, where the surface sticks
-# and the motor rattles in the backlash; fitted whole, that trace gave 6.2 %err median, and 2.7
-# with the samples above 10 Hz left out (BENCHMARKS.md, "Other commands").
-BAND_HZ = 10.0
 
-# The monitor's error at the true faults grows with the command's frequency, more than the signal:
-# on the calibration's fitting scenarios under the FDI chirp (24 actuators, noise off, 150 Hz
-# filtered) its RMS is 5.7 mA at 2-3 Hz and 10-12 mA at 7-10 Hz, while the current itself falls
-# from 390 to 230 mA (`python benchmarks/monitor_error_at_truth.py --by-frequency`). Least squares
-# weighted by the inverse of that error's variance, σ²(f) ∝ 1 + (f/f_c)², is the generalised least
-# squares of a model error that grows with f (`error_weights`); f_c = 2.38 Hz is the corner of that
-# variance fitted there. Checked on cases of their own (BENCHMARKS.md, "Frequency weights").
-ERROR_CORNER_HZ = 2.4
 
-# the error of fast motion outlasts it while the transient decays: `error_weights` reads the
-# frequency as the highest over the last this long [s]. On the chirp followed by a 50 ms ramp back
-# and a hold, read as slow motion the ramp and the stop held 82 % of eq. 3 at the truth of a
-# random case (`benchmarks/monitor_error_at_truth.py --command chirp-hold --only 1 --window 0.1`
-# before this rule); the FDI chirp, whose frequency only rises, is unchanged by it
-ERROR_MEMORY_S = 0.1
 
-# a turn of the command counts as a reversal once it has come back this fraction of its peak
-# excursion (so that a recorded command's quantisation or noise makes no reversals)
-REVERSAL_FRACTION = 0.01
 
 
 def command_frequency(theta_cmd: ArrayLike, f_s: float) -> NDArray[np.float64]:

@@ -6,5 +6,7 @@ paper's symbols. This sub-package imports nothing from the rest of emaphm; the A
 
 Layout (the block diagram): `controller` (ACE position PID), `pmsm_abc` (hysteresis inverter and
 three-phase stator), `mechanics` (gearbox, friction, backlash, end-stops), `sensors` (ADC),
-`transforms` (Clarke–Park), `hf_twin` (the one fixed-step loop of the high-fidelity twin).
+`transforms` (Clarke–Park), `hf_twin` (the one fixed-step loop of the high-fidelity twin),
+`monitor` (the low-fidelity monitor's loop and its population twin), `fitness` (eq. 3 fused with
+the monitor's population run and the comparison filter); `_jit` is the one njit helper.
 """

@@ -174,14 +174,14 @@ def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U
 # depends on its legs' switching state, which the monitor does not carry: on a locked rotor under the
 # twin's own comparators it was at rest in 0.514 ± 0.018 of 800 trials coming from a running loop and
 # 0.500 ± 0.018 coming from rest (on either zero vector), against 1.000 where both hold and < 0.01
-# where none does (`python benchmarks/loop_rest_study.py`). There the monitor carries the expected
+# where none does (`python studies/loop_rest_study.py`). There the monitor carries the expected
 # current, 1 − P(rest) ≈ 0.5 of the demand: least squares' best guess of a current that is either
 # the demand or nothing, at even odds.
 MAY_REST_CARRY = 0.5
 
 # No zero vector holds beyond |i_q,ref| = RING_OUTER · i_D at any angle: one holds while
 # |i_q,ref| · min(max_x u_x, −min_x u_x) < i_D (`standstill_dead_zone`), and that min is smallest,
-# 1/2, where one phase direction is ±1 and the other two ∓1/2. `fitness.moving_mask` leaves out the
+# 1/2, where one phase direction is ±1 and the other two ∓1/2. `weights.moving_mask` leaves out the
 # rests whose measured current is below this edge: there the twin's current is a coin flip.
 RING_OUTER = 2.0
 

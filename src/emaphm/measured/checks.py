@@ -170,6 +170,13 @@ def plausibility(trace: SimResult, params: EmaParams | None = None) -> list[str]
     Checks the span, each current (outliers, |i| vs I_max, constant) and position (outliers,
     |θ| vs theta_max) the trace holds, and, with ``theta_e``, that the rotor angle turns p·τ
     times ``theta_u`` (or ``theta_cmd``). See the module docstring for the thresholds.
+
+    Parameters
+    ----------
+    trace : SimResult
+        The trace, in SI.
+    params : EmaParams, optional
+        The actuator whose I_max and theta_max bound the signals (default: the nominal one).
     """
     params = params if params is not None else EmaParams()
     t = np.asarray(trace.t, dtype=np.float64)

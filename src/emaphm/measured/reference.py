@@ -194,6 +194,13 @@ def write_reference(reference: Reference, path: str | os.PathLike[str]) -> Path:
 
     The report travels in the metadata (``measured``, a JSON attribute); `emaphm.io.read_trace`
     gives it back as a dict.
+
+    Parameters
+    ----------
+    reference : Reference
+        A reference made by `to_reference`.
+    path : str or path
+        The file to write (``.h5`` or ``.csv``).
     """
     from ..io import write_trace
 

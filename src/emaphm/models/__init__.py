@@ -21,20 +21,10 @@ from ..errors import InputError
 from ..faults import HEALTHY
 from ..params import EmaParams
 from ..results import SimResult
-from ._base import check_seed, controller_pack, mechanics_pack
 from .hf import HighFidelityEma
-from .lf import MonitorEma, monitor_rows
+from .lf import MonitorEma
 
-__all__ = [
-    "HighFidelityEma",
-    "MonitorEma",
-    "check_seed",
-    "controller_pack",
-    "make_model",
-    "mechanics_pack",
-    "monitor_rows",
-    "simulate",
-]
+__all__ = ["HighFidelityEma", "MonitorEma", "make_model", "simulate"]
 
 MODELS: dict[str, type[HighFidelityEma] | type[MonitorEma]] = {"hf": HighFidelityEma, "lf": MonitorEma}
 
@@ -84,7 +74,21 @@ def make_model(
     monitor: str | None = None,
 ) -> HighFidelityEma | MonitorEma:
     """The model named `model` ("hf" or "lf"); `calibration` and `monitor` only for the monitor
-    model (`InputError` else)."""
+    model (`InputError` else).
+
+    Parameters
+    ----------
+    model : {"hf", "lf"}
+        The fidelity.
+    params : EmaParams, optional
+        The actuator (default: the paper's nominal one).
+    command : Command, optional
+        The position command (default: the FDI chirp).
+    calibration : Calibration or path, optional
+        The monitor model's calibration (``"lf"`` only; default: the packaged one).
+    monitor : {"default", "paper"}, optional
+        The monitor model (``"lf"`` only; None: the calibration's).
+    """
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; available: {', '.join(MODELS)}")
     if model == "lf":

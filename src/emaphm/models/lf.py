@@ -105,6 +105,8 @@ class MonitorEma(_EmaModel):
         The monitor model: "default" (the single-phase model with its loop-error surrogate,
         calibrated over multi-fault actuators and several commands) or "paper" (the paper's
         model, eqs. 1–2 alone, calibrated on the paper's scenarios). None: the calibration's.
+    allow_mismatch : bool
+        Accept a calibration made for other actuator parameters (to measure that mismatch).
     """
 
     model = "lf"

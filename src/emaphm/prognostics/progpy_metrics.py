@@ -15,16 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InputError
-
-try:
-    from progpy.predictors import ToEPredictionProfile
-    from progpy.uncertain_data import UnweightedSamples
-except ImportError as exc:  # pragma: no cover - exercised by the test without progpy
-    raise InputError(
-        "the ProgPy estimator needs the optional extra: pip install 'emaphm[progpy]' "
-        f"({type(exc).__name__}: {exc})"
-    ) from None
+from ._progpy import ToEPredictionProfile, UnweightedSamples
 
 __all__ = ["progpy_metrics", "toe_profile"]
 

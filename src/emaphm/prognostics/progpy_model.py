@@ -48,19 +48,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ._progpy import (
+    MonteCarlo,
+    MultivariateNormalDist,
+    PrognosticsModel,
+    UnscentedKalmanFilter,
+    UnweightedSamples,
+)
 from .progpy_metrics import progpy_metrics, toe_profile
 from .trend import LAWS, MIN_SD, DegradationTrend, RulEstimate, crossings, observed
-
-try:
-    from progpy import PrognosticsModel
-    from progpy.predictors import MonteCarlo
-    from progpy.state_estimators import UnscentedKalmanFilter
-    from progpy.uncertain_data import MultivariateNormalDist, UnweightedSamples
-except ImportError as exc:  # pragma: no cover - exercised by the test without progpy
-    raise InputError(
-        "the ProgPy estimator needs the optional extra: pip install 'emaphm[progpy]' "
-        f"({type(exc).__name__}: {exc})"
-    ) from None
 
 __all__ = [
     "FaultGrowth",

@@ -127,6 +127,15 @@ def parse_requirement(text: str, *, params: EmaParams | None = None, where: str 
     I_max is refused when `params` is given (`derive_thresholds` checks it in any case).
     `InputError` naming `where` for an unknown kind, a unit of another kind, or a limit that is
     not > 0.
+
+    Parameters
+    ----------
+    text : str
+        ``KIND=LIMIT`` (above); the limit in SI or with a unit suffix.
+    params : EmaParams, optional
+        The actuator whose I_max a fraction refers to.
+    where : str
+        The option or table the text came from, for the error message.
     """
     if not isinstance(text, str) or "=" not in text:
         raise InputError(f"{where}: {text!r} must be KIND=LIMIT, e.g. tracking=0.5deg")

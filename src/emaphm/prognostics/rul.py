@@ -127,7 +127,27 @@ def rul_report(
     the last one stored), JSON-ready; see the module docstring. `estimator`: "trend"
     (`DegradationTrend`, no dependency) or "ukf" (ProgPy's unscented Kalman filter on the
     `progpy_model.FaultGrowth` model; the ``progpy`` extra). ``_trends`` and ``_estimates`` (not
-    JSON) hold the fitted trends and the draws, for a plot."""
+    JSON) hold the fitted trends and the draws, for a plot.
+
+    Parameters
+    ----------
+    store : str or path
+        The campaign's results store (a directory, `emaphm.campaign`).
+    actuator : str
+        The actuator's id in the store.
+    campaign : str, optional
+        The campaign's name, when the store holds several.
+    at_flight : int, optional
+        The flight the RUL is computed as of (default: the last one stored).
+    thresholds : dict of str to float, optional
+        Failure threshold per fault, in fault units from healthy (default: the placeholders).
+    inspection_interval : float
+        Flights to the next inspection, for the probability of failing before it [flights].
+    seed : int
+        Seed of the draws of the first failure's distribution.
+    estimator : {"trend", "ukf"}
+        The tracker (above).
+    """
     if estimator not in ESTIMATORS:
         raise InputError(f"unknown estimator {estimator!r}; use one of {', '.join(ESTIMATORS)}")
     if estimator == "ukf":

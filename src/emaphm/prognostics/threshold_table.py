@@ -38,6 +38,11 @@ def thresholds_toml(result: dict[str, Any]) -> str:
     threshold that errs, errs early) and commented with the requirement that limits it; the
     header names the actuator, the command, the requirements, and the faults left out (for which
     ``emaphm rul`` falls back to its placeholders). `emaphm.actuator.load_thresholds` reads it.
+
+    Parameters
+    ----------
+    result : dict
+        What `derive_thresholds` returned.
     """
     reqs = {r["kind"]: r for r in result["requirements"]}
     given = ", ".join(f"{r['kind']} = {r['text']}" for r in result["requirements"])

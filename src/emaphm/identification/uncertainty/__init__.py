@@ -43,10 +43,27 @@ from .intervals import (
     to_faults,
     verdicts,
 )
-from .laplace import STEPS, integrated_time, laplace, sandwich
+from .laplace import LAPLACE_STEPS, integrated_time, laplace, sandwich
 
 __all__ = [
-    "FIT_COVERAGE", "PACKAGED_FACTORS", "PHASE", "STEPS", "UQ_METHODS", "Z90", "ZETA", "Factors", "Uncertainty",
-    "covers", "fit_factors", "half_widths", "integrated_time", "intervals", "laplace", "load_factors", "sandwich",
-    "to_cartesian", "to_faults", "verdicts",
+    "FIT_COVERAGE",
+    "LAPLACE_STEPS",
+    "PACKAGED_FACTORS",
+    "PHASE",
+    "UQ_METHODS",
+    "Z90",
+    "ZETA",
+    "Factors",
+    "Uncertainty",
+    "covers",
+    "fit_factors",
+    "half_widths",
+    "integrated_time",
+    "intervals",
+    "laplace",
+    "load_factors",
+    "sandwich",
+    "to_cartesian",
+    "to_faults",
+    "verdicts",
 ]  # fmt: skip

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...faults import FAULT_NAMES, HEALTHY
+from ..limits import PHASE_SIGMAS
 
 __all__ = [
     "N_PARAMS", "PHASE", "PHASE_SIGMAS", "Z90", "Z90_ONE", "ZETA", "Uncertainty", "covers", "half_widths",
@@ -22,7 +23,6 @@ __all__ = [
 
 Z90 = 1.6448536269514722  # two-sided 90 %: the 95 % normal quantile
 Z90_ONE = 1.2815515655446004  # one-sided 90 %
-PHASE_SIGMAS = 2.0  # the direction is undefined while ζ̂ < this many σ(ζ)
 N_PARAMS = len(FAULT_NAMES)
 ZETA, PHASE = 5, 6  # indices of k6 (ζ) and k7 (its direction) in the fault vector
 
@@ -46,7 +46,18 @@ def to_faults(U: ArrayLike) -> NDArray[np.float64]:
 
 @dataclass(frozen=True)
 class Uncertainty:
-    """Per-fault uncertainty of one estimate (k units; k7 in turns of the circle)."""
+    """Per-fault uncertainty of one estimate (k units; k7 in turns of the circle).
+
+    method : str  how the σ were found: "laplace" or "mcmc"
+    std : ndarray  calibrated σ per fault
+    ci90_low, ci90_high : ndarray  the 90 % intervals' ends (k7 may wrap: low > high)
+    corr : ndarray  8 × 8 correlation matrix
+    flags : list of list of str  per fault: at_bound, nonsmooth, phase_undefined, non_identifiable
+    raw_std : ndarray  σ before the discrepancy calibration (noise only)
+    evaluations : int  LF model evaluations spent on the intervals
+    details : dict  the method's diagnostics (τ, steps, wall time, ...)
+    cov_u : ndarray or None  covariance of u = (k1..k5, e_x, e_y, k8), noise only
+    """
 
     method: str
     std: NDArray[np.float64]  # calibrated σ per fault (NaN for k7 when its direction is undefined)
@@ -145,12 +156,22 @@ def intervals(
 
 
 def verdicts(
-    k_hat: ArrayLike, low: ArrayLike, high: ArrayLike, thresholds: dict[str, float]
+    estimate: ArrayLike, low: ArrayLike, high: ArrayLike, thresholds: dict[str, float]
 ) -> dict[str, str]:
     """Per detectable fault: "present" when its 90 % interval excludes the healthy value by more than
     the threshold, "absent" when the estimate is within the threshold of healthy, else "cannot tell"
-    (the estimate departs, but the interval reaches back to within the threshold of healthy)."""
-    k, lo, hi = (np.asarray(a, dtype=np.float64) for a in (k_hat, low, high))
+    (the estimate departs, but the interval reaches back to within the threshold of healthy).
+
+    Parameters
+    ----------
+    estimate : array_like of 8 floats in [0, 1]
+        The identified fault vector k1..k8.
+    low, high : array_like of 8 floats
+        The ends of the 90 % intervals (`Uncertainty.ci90_low`, `Uncertainty.ci90_high`).
+    thresholds : dict of str to float
+        The detection threshold of each fault, in fault units above healthy (`detect`).
+    """
+    k, lo, hi = (np.asarray(a, dtype=np.float64) for a in (estimate, low, high))
     out: dict[str, str] = {}
     for j, name in enumerate(FAULT_NAMES):
         if name not in thresholds:

@@ -21,15 +21,20 @@ if TYPE_CHECKING:
     from ...models import MonitorEma
     from ..fitness import Fitness
 
-__all__ = ["HAC_TAUS", "NONSMOOTH_RATIO", "NON_IDENTIFIABLE", "PINV_RCOND", "SOKAL_C", "STEPS", "integrated_time",
-           "laplace", "sandwich"]  # fmt: skip
+from ..limits import HAC_TAUS, LAPLACE_STEPS, NON_IDENTIFIABLE, NONSMOOTH_RATIO, PINV_RCOND, SOKAL_C
 
-STEPS = (1e-3, 3e-3)  # central-difference steps in k units
-NONSMOOTH_RATIO = 1.5  # σ differing by more than this between the two steps: nonsmooth
-NON_IDENTIFIABLE = 1e-6  # eigenvalue of JᵀJ below this fraction of the largest
-SOKAL_C = 5.0  # Sokal's window: the smallest M with M ≥ c·τ(M)
-PINV_RCOND = 1e-12  # directions of JᵀJ below this fraction of the largest are dropped (σ → ∞)
-HAC_TAUS = 5.0  # the sandwich's Bartlett window spans this many autocorrelation times
+__all__ = [
+    "HAC_TAUS",
+    "LAPLACE_STEPS",
+    "NONSMOOTH_RATIO",
+    "NON_IDENTIFIABLE",
+    "PINV_RCOND",
+    "SOKAL_C",
+    "integrated_time",
+    "laplace",
+    "sandwich",
+]  # fmt: skip
+
 
 
 def integrated_time(r: ArrayLike, c: float = SOKAL_C) -> float:
@@ -120,11 +125,11 @@ def laplace(
     factors = factors if factors is not None else Factors.identity()
     keep = objective.weights > 0
     sw = np.sqrt(objective.weights[keep])
-    ref = objective.reference.reference[keep]
+    ref = objective.comparison.reference[keep]
     n = int(keep.sum())
     rows = [u0]
     spans = []
-    for h in STEPS:
+    for h in LAPLACE_STEPS:
         for j in range(N_PARAMS):
             up, down = u0.copy(), u0.copy()
             if j in (ZETA, PHASE):  # the pair is free (ζ ≤ 1 is kept by `to_faults`' range)
@@ -136,7 +141,7 @@ def laplace(
             spans.append(up[j] - down[j])
     K = np.clip(to_faults(np.array(rows)), 0.0, 1.0)
     currents = monitor.simulate_many(K, duration=duration, check=False)
-    R = sw * (ref - objective.reference.filtered(currents)[:, keep])
+    R = sw * (ref - objective.comparison.filtered(currents)[:, keep])
     r0 = R[0]
     if not np.all(np.isfinite(r0)):
         raise InputError("the monitor diverges at the estimate: no uncertainty can be given")
@@ -144,7 +149,7 @@ def laplace(
     s2 = ssr / max(n - N_PARAMS, 1)
     tau = integrated_time(r0)
     covs, sds = [], []
-    for q in range(len(STEPS)):
+    for q in range(len(LAPLACE_STEPS)):
         J = _jacobian(R, rows, spans, u0, q, n)
         cov_u = sandwich(J, r0, tau)  # pinv at `PINV_RCOND`
         cov_k = _delta_to_faults(u0, cov_u)
@@ -173,7 +178,7 @@ def laplace(
         "residual_tau": round(tau, 2),
         "s2": s2,
         "n_eff": round(n / tau, 1),
-        "steps": list(STEPS),
+        "steps": list(LAPLACE_STEPS),
         "non_identifiable": combos,
         "calibrated": bool(factors.record),
     }

@@ -9,8 +9,8 @@ with err the eq. (3) fitness and τ, s² from the Laplace step (the residual's a
 and variance): the likelihood of the filtered residual tempered by τ. The prior is uniform in
 (k1..k5, e_x, e_y, k8) over the box and the disc ζ ≤ 1 (uniform in the pair, not in (ζ, k7)).
 Each proposal half-ensemble is one population call. 32 walkers start from N(û, Cov_Laplace/4);
-the chain runs in chunks of `CHUNK` steps until it is ≥ 50 autocorrelation times long and τ
-changed < 1 % between chunks, or `MAX_STEPS` (then ``converged`` is false and the result warns).
+the chain runs in chunks of `limits.CHUNK` steps until it is ≥ 50 autocorrelation times long and τ
+changed < 1 % between chunks, or `limits.MAX_STEPS` (then ``converged`` is false and the result warns).
 3 τ are discarded and the rest thinned by τ/2.
 
 Intervals are the 5–95 % quantiles; one-sided [0, q90] (``at_bound``) when more than 5 % of the
@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from ...errors import InputError
 from ...faults import FAULT_NAMES
+from .. import limits
 from .factors import Factors
 from .intervals import PHASE, Z90, ZETA, Uncertainty, to_cartesian, to_faults
 
@@ -38,13 +39,8 @@ if TYPE_CHECKING:
     from ...models import MonitorEma
     from ..fitness import Fitness
 
-__all__ = ["CHUNK", "MAX_STEPS", "WALKERS", "check_emcee", "sample"]
+__all__ = ["check_emcee", "sample"]
 
-WALKERS = 32
-CHUNK = 500
-MAX_STEPS = 10_000
-MIN_TAUS = 50  # chain length in autocorrelation times before it counts as converged
-TAU_RTOL = 0.01
 
 
 def check_emcee() -> None:
@@ -64,7 +60,7 @@ def sample(
     duration: float,
     factors: Factors,
     seed: int,
-    walkers: int = WALKERS,
+    walkers: int | None = None,
     chunk: int | None = None,
     max_steps: int | None = None,
     on_step: Callable[[int, int, float], None] | None = None,
@@ -75,8 +71,9 @@ def sample(
     import emcee
 
     check_emcee()
-    chunk = CHUNK if chunk is None else chunk  # the module's values at call time
-    max_steps = MAX_STEPS if max_steps is None else max_steps
+    walkers = limits.WALKERS if walkers is None else walkers  # the registry's values at call time
+    chunk = limits.CHUNK if chunk is None else chunk
+    max_steps = limits.MAX_STEPS if max_steps is None else max_steps
     u0 = to_cartesian(k_hat)[0]
     tau_r, s2 = float(local.details["residual_tau"]), float(local.details["s2"])
     temper = 2.0 * tau_r * s2
@@ -115,8 +112,8 @@ def sample(
         t_max = float(np.max(tau))
         if (
             np.isfinite(t_max)
-            and sampler.iteration >= MIN_TAUS * t_max
-            and abs(old_tau - t_max) < TAU_RTOL * t_max
+            and sampler.iteration >= limits.MIN_TAUS * t_max
+            and abs(old_tau - t_max) < limits.TAU_RTOL * t_max
         ):
             converged = True
             break
