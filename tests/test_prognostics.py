@@ -149,3 +149,16 @@ def test_correlated_estimates_make_correlated_trends_for_the_first_failure(tmp_p
         sd = (f["rul_p95"] - f["rul_p05"]) / 3.29
         gaps.append((f["rul_median"] - report["first_failure"]["rul_median"]) / sd)
     assert 0.4 < gaps[0] < 0.75 and 0.0 <= gaps[1] < 0.2
+
+
+def test_the_most_likely_fault_counts_only_the_draws_in_which_one_fails():
+    # review M6: 25 % of draws never failing were counted as failures of the first fault listed
+    from emaphm.prognostics.rul import most_likely_fault
+
+    inf = np.inf
+    friction = np.array([inf] * 25 + [10.0] * 32 + [50.0] * 43)
+    backlash = np.array([inf] * 25 + [20.0] * 32 + [30.0] * 43)
+    assert most_likely_fault(["friction", "backlash"], np.vstack([friction, backlash])) == "backlash"
+    never = np.full((2, 100), inf)
+    never[0, :10] = 5.0
+    assert most_likely_fault(["friction", "backlash"], never) is None  # most draws never fail

@@ -374,3 +374,86 @@ def test_a_results_row_records_the_second_search(tmp_path, monkeypatch):
         and record["first_evaluations"] + record["second_evaluations"] == (rows["true"]["evaluations"])
     )
     assert rows["false"]["second_search"] is None
+
+
+def test_a_change_of_code_data_or_settings_redoes_the_jobs_and_says_so(tmp_path, monkeypatch):
+    # review H1: the key hashed a version string that never moved, so an upgrade (a new packaged
+    # calibration, a new default) left every stored result "done"
+    from emaphm.campaign import fingerprint
+    from emaphm.identification import limits
+
+    spec = write_spec(tmp_path)
+    out = tmp_path / "store"
+    first = run_campaign(spec, out, scheduler="serial")
+    jobs = load_campaign(spec).jobs()
+    assert first.done == 12 and first.stale == 0 and len({j.fingerprint for j in jobs}) == 1
+    rows = ResultStore(out).read().to_pylist()
+    assert {r["fingerprint"] for r in rows} == {jobs[0].fingerprint}
+    # other code or packaged data (here: another source hash); the keys stay, the fingerprints move
+    monkeypatch.setattr(fingerprint, "code_hash", lambda: "another version")
+    moved = load_campaign(spec).jobs()
+    assert [j.key for j in moved] == [j.key for j in jobs] and moved[0].fingerprint != jobs[0].fingerprint
+    assert campaign_status(spec, out)["stale"] == 12
+    kept = run_campaign(spec, out, scheduler="serial", keep_stale=True)
+    assert (kept.submitted, kept.stale, kept.kept_stale) == (0, 12, True)
+    redone = run_campaign(spec, out, scheduler="serial")
+    assert (redone.submitted, redone.done, redone.stale) == (12, 12, 12)
+    rows = ResultStore(out).read().to_pylist()  # one row per job, the latest: never two fingerprints
+    assert len(rows) == 12 and {r["fingerprint"] for r in rows} == {moved[0].fingerprint}
+    assert campaign_status(spec, out)["stale"] == 0
+    # a tuned constant of the stages moves it too (it is recorded in every result)
+    monkeypatch.setattr(limits, "FIT_NRMSE_WARN", 0.07)
+    assert load_campaign(spec).jobs()[0].fingerprint != moved[0].fingerprint
+
+
+def test_a_job_written_twice_is_read_once_the_latest(tmp_path):
+    # review M2: a retried flush wrote a result row twice and rul counted the flight twice
+    store = ResultStore(tmp_path)
+    row = {"job_key": "k1", "campaign": "c", "actuator": "A", "flight": 1, "seed": 1, "finished": "2026-01-01T00:00:00"}
+    store.write("results", [row])
+    store.write("results", [{**row, "fitness": 2.0, "finished": "2026-01-02T00:00:00"}])
+    store.write("results", [{**row, "job_key": "k2"}])
+    table = store.read()
+    assert table.num_rows == 2 and sorted(table.column("job_key").to_pylist()) == ["k1", "k2"]
+    latest = {r["job_key"]: r for r in table.to_pylist()}
+    assert latest["k1"]["fitness"] == 2.0 and store.keys() == {"k1", "k2"}
+
+
+def test_a_failed_store_write_neither_fails_a_done_job_nor_writes_it_twice(tmp_path, monkeypatch):
+    # review M2: one failed write recorded a job that had succeeded as failed and wrote its row twice
+    from emaphm.campaign import runner
+
+    spec = write_spec(tmp_path)
+    out = tmp_path / "store"
+    monkeypatch.setattr(runner, "run_job", lambda job: {
+        "job_key": job["key"], "campaign": job["campaign"], "actuator": job["actuator"], "flight": job["flight"],
+        "seed": job["seed"], "finished": "2026-01-01T00:00:00", "fingerprint": job["fingerprint"],
+    })  # fmt: skip
+    original, calls = ResultStore.write, []
+
+    def write_once_failing(self, kind, rows):  # type: ignore[no-untyped-def]
+        calls.append(kind)
+        if kind == "failures" and calls.count("failures") == 1:
+            raise OSError(28, "No space left on device")
+        return original(self, kind, rows)
+
+    monkeypatch.setattr(ResultStore, "write", write_once_failing)
+    with pytest.raises(OSError, match="No space left"):
+        run_campaign(spec, out, scheduler="serial", flush_rows=3)
+    summary = run_campaign(spec, out, scheduler="serial", flush_rows=3)
+    rows = ResultStore(out).read().to_pylist()
+    assert summary.failed == 0 and len(rows) == 12 and len({r["job_key"] for r in rows}) == 12
+    assert ResultStore(out).read("failures").num_rows == 0
+
+
+def test_serial_and_dask_treat_a_jobs_programming_error_alike(tmp_path, monkeypatch):
+    # review L9: the serial path aborted the campaign on a KeyError that Dask recorded and skipped
+    from emaphm.campaign import runner
+
+    def broken(job):  # type: ignore[no-untyped-def]
+        raise KeyError("a bug in one job")
+
+    monkeypatch.setattr(runner, "run_job", broken)
+    summary = run_campaign(write_spec(tmp_path), tmp_path / "store", scheduler="serial")
+    failures = ResultStore(tmp_path / "store").read("failures").to_pylist()
+    assert summary.failed == 12 and {f["error"] for f in failures} == {"KeyError"}

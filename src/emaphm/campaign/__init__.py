@@ -1,11 +1,12 @@
 """Fleet campaigns (issue 11): many identifications from one file, on Dask, into a results store
 that survives interruption.
 
-- `spec`: the campaign file (TOML) and its jobs with stable content keys;
+- `spec`: the campaign file (TOML) and its jobs with stable content keys; `identify_table` its
+  ``[identify]`` table; `fingerprint` what computes a job (code, packaged data, settings);
 - `actuators`: its ``[[actuator]]`` and ``[[fleet]]`` tables, histories grown flight by flight;
 - `jobs`: one job, run anywhere from plain data (`run_job`);
 - `store`: the Parquet results store, written atomically;
-- `runner`: `run_campaign` (the missing jobs only; Dask or serial) and `campaign_status`.
+- `runner`: `run_campaign` (the missing and stale jobs only; Dask or serial); `status`: `campaign_status`.
 
 ``emaphm campaign run SPEC.toml --out DIR`` and ``emaphm campaign status SPEC.toml DIR`` are the
 command line; docs/campaigns.md the guide.
@@ -14,8 +15,9 @@ command line; docs/campaigns.md the guide.
 from __future__ import annotations
 
 from .jobs import run_job
-from .runner import CampaignSummary, campaign_status, run_campaign
+from .runner import CampaignSummary, run_campaign
 from .spec import CampaignSpec, Job, history_seed, load_campaign
+from .status import campaign_status
 from .store import ResultStore
 
 __all__ = [

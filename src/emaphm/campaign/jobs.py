@@ -45,7 +45,7 @@ def _pool() -> int:
 
 
 def _now() -> str:
-    return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+    return _dt.datetime.now(_dt.UTC).isoformat(timespec="microseconds")  # orders a redone job's rows
 
 
 def run_job(job: dict[str, Any]) -> dict[str, Any]:
@@ -73,6 +73,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
         "second_search": json.dumps(second) if (second := stage_record(data["settings"], "second_search") or {}).get("ran") else None,
         "reference_sha256": job["reference_sha256"], "settings": json.dumps(job["settings"], sort_keys=True),
         "warnings": json.dumps(data["warnings"]), "worker": _worker(), "finished": _now(), "version": __version__,
+        "fingerprint": job.get("fingerprint") or None,
         "numba_threads": _pool(),
     }  # fmt: skip
     for j, k in enumerate(K):

@@ -24,7 +24,6 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
@@ -32,7 +31,7 @@ from .jobs import failure_row, run_job
 from .spec import CampaignSpec, load_campaign
 from .store import ResultStore
 
-__all__ = ["CampaignSummary", "campaign_status", "run_campaign"]
+__all__ = ["CampaignSummary", "run_campaign"]
 
 Progress = Callable[[int, int, int, float], None]  # done, failed, to do, elapsed [s]
 
@@ -40,7 +39,8 @@ Progress = Callable[[int, int, int, float], None]  # done, failed, to do, elapse
 @dataclass(frozen=True)
 class CampaignSummary:
     """What a run did: `campaign` (its name), `jobs` (in the spec), `already_done` (in the store
-    before), `submitted`, `done`, `failed` (this run's), `wall_time_s` and `startup_s` (the wall time,
+    before, made by this code and data), `stale` (stored rows made by other code, data or settings:
+    redone, or kept when `kept_stale`), `submitted`, `done`, `failed` (this run's), `wall_time_s` and `startup_s` (the wall time,
     and the cluster's start and compile-cache warm-up before the first job [s]), `backend` (where
     the jobs ran) and `workers` (how many ran at once)."""
 
@@ -54,6 +54,8 @@ class CampaignSummary:
     backend: str
     workers: int
     startup_s: float = 0.0
+    stale: int = 0
+    kept_stale: bool = False
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -86,18 +88,22 @@ def run_campaign(
     progress: Progress | None = None,
     flush_rows: int = 20,
     flush_seconds: float = 10.0,
+    keep_stale: bool = False,
 ) -> CampaignSummary:
     """Run the jobs of `spec` (a `CampaignSpec` or its file) that the results store `out` (a directory)
     does not hold yet (module docstring). `scheduler`: a Dask scheduler's address or "serial" (None:
     ``DASK_SCHEDULER_ADDRESS``, else a local cluster of `workers` processes, one per core if None);
-    `progress` (done, failed, to_do, elapsed_s); rows are written each `flush_rows` or `flush_seconds` [s]."""
+    `progress` (done, failed, to_do, elapsed_s); rows are written each `flush_rows` or `flush_seconds` [s].
+    A stored row made by other code, data or settings (its fingerprint, `fingerprint`) is redone,
+    or kept with `keep_stale`; the latest row of a job is the one read."""
     spec = _spec(spec)
     store = ResultStore(out)
     jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work
     address, cores, serial = _backend(scheduler, workers)
     store.remove_temporaries()
-    done_keys = store.keys("results", spec.name)
-    todo = [j for j in jobs if j.key not in done_keys]
+    stored = store.fingerprints(spec.name)
+    stale = sum(1 for j in jobs if j.key in stored and stored[j.key] != j.fingerprint)
+    todo = [j for j in jobs if j.key not in stored or (stored[j.key] != j.fingerprint and not keep_stale)]
     start = time.perf_counter()
     collector = _Collector(store, len(todo), progress, flush_rows, flush_seconds, start)
     n_workers = 1
@@ -113,7 +119,8 @@ def run_campaign(
     finally:
         collector.flush(force=True)
     return CampaignSummary(
-        campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo),
+        campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo), stale=stale,
+        kept_stale=keep_stale,
         done=collector.done, failed=collector.failed, wall_time_s=round(time.perf_counter() - start, 3),
         backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
     )  # fmt: skip
@@ -166,9 +173,12 @@ class _Collector:
             or len(self.rows) + len(self.failures) >= self.flush_rows
             or time.monotonic() - self.last_flush >= self.flush_seconds
         ):
+            # each buffer cleared right after its own write: a failed write of one never writes
+            # the other twice (review M2)
             self.store.write("results", self.rows)
+            self.rows = []
             self.store.write("failures", self.failures)
-            self.rows, self.failures, self.last_flush = [], [], time.monotonic()
+            self.failures, self.last_flush = [], time.monotonic()
 
     def finished(self, row: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
         if row is not None:
@@ -187,9 +197,11 @@ def _run_serial(todo: list[Any], finished: Callable[[Any, Any], None]) -> None:
     for job in todo:
         payload = job.to_dict()
         try:
-            finished(run_job(payload), None)
-        except (InputError, ArithmeticError, RuntimeError, ValueError, OSError) as exc:
+            row = run_job(payload)
+        except Exception as exc:  # as on Dask: the job's error recorded, the campaign goes on (review L9)
             finished(None, failure_row(payload, exc))
+        else:  # outside the try: a failed store write is not this job's failure (review M2)
+            finished(row, None)
 
 
 def _run_dask(
@@ -273,28 +285,3 @@ def _restore_environ(saved: dict[str, str]) -> None:
     for key, value in saved.items():
         if os.environ.get(key) != value:
             os.environ[key] = value
-
-
-def campaign_status(
-    spec: CampaignSpec | str | os.PathLike[str], out: str | os.PathLike[str]
-) -> dict[str, Any]:
-    """Done, failed (and not done since) and missing jobs of `spec` in `out`, in all and per actuator;
-    ``other_rows``: stored rows of this campaign that no job of `spec` has (an older file or version)."""
-    spec = _spec(spec)
-    store = ResultStore(out)
-    jobs = spec.jobs()
-    done, failed_keys = store.keys("results", spec.name), store.keys("failures", spec.name)
-    per: dict[str, dict[str, int]] = {}
-    totals = {"jobs": len(jobs), "done": 0, "failed": 0, "missing": 0}
-    for job in jobs:
-        state = "done" if job.key in done else "failed" if job.key in failed_keys else "missing"
-        entry = per.setdefault(job.actuator, {"jobs": 0, "done": 0, "failed": 0, "missing": 0})
-        entry["jobs"] += 1
-        entry[state] += 1
-        totals[state] += 1
-    keys = {j.key for j in jobs}
-    rows = store.read("results", spec.name, columns=["job_key"]).num_rows
-    return {
-        "campaign": spec.name, "store": str(Path(out)), **totals, "stored_rows": rows,
-        "other_rows": len(done - keys), "actuators": per,
-    }  # fmt: skip

@@ -66,7 +66,7 @@ The ``[[actuator]]`` and ``[[fleet]]`` tables are read by `emaphm.campaign.actua
 
 from __future__ import annotations
 
-import dataclasses
+import collections
 import hashlib
 import json
 import os
@@ -80,16 +80,15 @@ from .._version import __version__
 from ..errors import InputError
 from ..io import read_toml, sha256_of
 from .actuators import ID_PATTERN, CampaignActuator, parse_actuator, parse_fleet
+from .fingerprint import fingerprint
+from .identify_table import IDENTIFY_FILES, parse_identify
 
 __all__ = ["CampaignSpec", "Job", "history_seed", "load_campaign"]
 
 TOP_KEYS = {"campaign", "identify", "actuator", "fleet"}
 CAMPAIGN_KEYS = {"name", "seeds", "description"}
 # identify() settings a campaign may set, with their checks; file paths resolved to the spec's folder
-# the [identify] table: the fields of `IdentifySettings` but the seed (the campaign draws one per
-# job) and the threads (one per job), and identify's input files, resolved to the campaign's folder
-IDENTIFY_FILES = ("calibration", "uq_calibration", "params")
-NOT_IN_CAMPAIGNS = ("seed", "workers")
+
 
 
 def history_seed(seed: int, flight: int) -> int:
@@ -107,6 +106,8 @@ class Job:
     truth : tuple of 8 floats or None  the twin's fault vector (None: a recording is read)
     reference, reference_sha256, channel_map : str or None  the recording, its digest, its channel map
     settings : dict  `identify`'s settings; key : str  the job's content key in the store
+    fingerprint : str  what computes it: the code, the packaged data, the settings after defaults
+    (`fingerprint.fingerprint`); a stored row with another was made by other code or data
     """
 
     campaign: str
@@ -120,6 +121,7 @@ class Job:
     channel_map: str | None
     settings: dict[str, Any]
     key: str = ""
+    fingerprint: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -127,6 +129,7 @@ class Job:
             "identify_seed": self.identify_seed, "truth": None if self.truth is None else list(self.truth),
             "reference": self.reference, "reference_sha256": self.reference_sha256,
             "channel_map": self.channel_map, "settings": dict(self.settings), "key": self.key,
+            "fingerprint": self.fingerprint,
         }  # fmt: skip
 
 
@@ -160,11 +163,15 @@ class CampaignSpec:
             return digests[path]
 
         out = []
+        prints: dict[str, str] = {}  # one fingerprint per distinct settings (a fleet shares them)
         for act in self.actuators:
             settings = {**self.settings, **act.overrides}
             hashed = {
-                k: (digest(Path(v)) if k in _FILE_KEYS and v is not None else v) for k, v in settings.items()
+                k: (digest(Path(v)) if k in IDENTIFY_FILES and v is not None else v) for k, v in settings.items()
             }
+            text = json.dumps(settings, sort_keys=True, default=str)
+            if text not in prints:
+                prints[text] = fingerprint(settings, digest, IDENTIFY_FILES)
             cmap = str(act.channel_map) if act.channel_map is not None else None
             flights: list[tuple[int, tuple[float, ...] | None, Path | None]]
             if act.kind == "faults":
@@ -185,58 +192,22 @@ class CampaignSpec:
                         "map_sha256": None if act.channel_map is None else digest(act.channel_map),
                         "settings": hashed, "version": __version__,
                     }  # fmt: skip
-                    text = json.dumps(content, sort_keys=True, separators=(",", ":"))
+                    content_text = json.dumps(content, sort_keys=True, separators=(",", ":"))
                     out.append(
                         Job(
                             campaign=self.name, actuator=act.id, flight=flight, seed=seed,
                             identify_seed=history_seed(seed, flight) if act.kind == "history" else seed,
                             truth=truth, reference=None if ref is None else str(ref),
                             reference_sha256=ref_sha, channel_map=cmap,
-                            settings=settings, key=hashlib.sha256(text.encode()).hexdigest()[:20],
+                            settings=settings, key=hashlib.sha256(content_text.encode()).hexdigest()[:20],
+                            fingerprint=prints[text],
                         )
                     )  # fmt: skip
         return out
 
 
-_FILE_KEYS = ("calibration", "uq_calibration", "params")
-
-
 def _fail(where: str, message: str) -> InputError:
     return InputError(f"{where}: {message}")
-
-
-def identify_keys() -> list[str]:
-    """The keys an [identify] table may hold (`IdentifySettings`' fields and the input files)."""
-    from ..identification.settings import IdentifySettings
-
-    fields = [f.name for f in dataclasses.fields(IdentifySettings) if f.name not in NOT_IN_CAMPAIGNS]
-    return [*fields, *IDENTIFY_FILES]
-
-
-def _parse_identify(data: Any, folder: Path, where: str) -> dict[str, Any]:
-    """The [identify] table checked as `IdentifySettings` checks it; the keys given, with their
-    values as identify takes them ("off" -> None) and the files' absolute paths."""
-    from ..identification.settings import IdentifySettings
-
-    if not isinstance(data, dict):
-        raise _fail(where, "[identify] must be a table")
-    known = identify_keys()
-    unknown = sorted(set(data) - set(known))
-    if unknown:
-        raise _fail(where, f"[identify] unknown key(s) {', '.join(unknown)}; known: {', '.join(known)}")
-    options = {k: v for k, v in data.items() if k not in IDENTIFY_FILES}
-    try:
-        settings = IdentifySettings.from_mapping(options, where="[identify]")
-    except InputError as exc:
-        raise _fail(where, f"[identify] {exc}") from None
-    out: dict[str, Any] = {key: getattr(settings, key) for key in options}
-    for key in IDENTIFY_FILES:
-        if key in data:
-            value = data[key]
-            if not isinstance(value, str) or not (folder / value).is_file():
-                raise _fail(where, f"[identify] {key} = {value!r}: no such file")
-            out[key] = str((folder / value).resolve())
-    return out
 
 
 def load_campaign(path: str | os.PathLike[str]) -> CampaignSpec:
@@ -279,7 +250,7 @@ def load_campaign(path: str | os.PathLike[str]) -> CampaignSpec:
     if not isinstance(description, str):
         raise _fail(where, "[campaign] description must be text")
     folder = p.resolve().parent
-    settings = _parse_identify(data.get("identify", {}), folder, where)
+    settings = parse_identify(data.get("identify", {}), folder, where)
     raw, fleets = data.get("actuator", []), data.get("fleet", [])
     if not isinstance(raw, list) or not isinstance(fleets, list) or not (raw or fleets):
         raise _fail(where, "no [[actuator]] or [[fleet]]: a campaign needs at least one actuator")
@@ -287,7 +258,7 @@ def load_campaign(path: str | os.PathLike[str]) -> CampaignSpec:
         a for i, f in enumerate(fleets) for a in parse_fleet(f, i, folder, where)
     )
     ids = [a.id for a in actuators]
-    twice = sorted({i for i in ids if ids.count(i) > 1})
+    twice = sorted(i for i, n in collections.Counter(ids).items() if n > 1)  # linear in the fleet (review M4)
     if twice:
         raise _fail(where, f"actuator id(s) given twice: {', '.join(twice)}")
     return CampaignSpec(name, tuple(seeds), settings, actuators, where, description)

@@ -44,6 +44,7 @@ RESULT_COLUMNS: dict[str, str] = {
     "fit_nrmse": "float64", "fitness": "float64", "evaluations": "int64", "wall_time_s": "float64",
     "second_search": "string", "reference": "string", "reference_sha256": "string", "settings": "string", "warnings": "string",
     "worker": "string", "numba_threads": "int64", "finished": "string", "version": "string",
+    "fingerprint": "string",  # what computed the row (`fingerprint`); null in stores made before it
 }  # fmt: skip
 FAILURE_COLUMNS: dict[str, str] = {
     "job_key": "string", "flight": "int64", "seed": "int64", "error": "string", "message": "string",
@@ -128,14 +129,35 @@ class ResultStore:
         schema = pa.schema(
             [(n, getattr(pa, t)()) for n, t in base.items()] + [(p, pa.string()) for p in PARTITIONS]
         )
+        extra = [n for n in ("job_key", "finished") if n not in names]  # what the latest row per job needs
         try:
             data = ds.dataset(folder, format="parquet", partitioning=partitioning, schema=schema)
             filt = (ds.field("campaign") == campaign) if campaign is not None else None
-            return data.to_table(columns=names, filter=filt)
+            table = data.to_table(columns=[*names, *extra], filter=filt)
         except (pa.ArrowInvalid, OSError) as exc:
             raise InputError(f"{folder}: a part file cannot be read ({exc})".splitlines()[0]) from None
+        return _latest_per_job(table).drop_columns(extra) if kind == "results" else table.drop_columns(extra)
+
+    def fingerprints(self, campaign: str | None = None) -> dict[str, str | None]:
+        """The fingerprint of each stored job's latest result row (None: a row made before them)."""
+        table = self.read("results", campaign, columns=["job_key", "fingerprint"])
+        return dict(zip(table.column("job_key").to_pylist(), table.column("fingerprint").to_pylist(), strict=True))
 
     def keys(self, kind: str = "results", campaign: str | None = None) -> set[str]:
         """The job keys stored in ``kind`` (of one campaign)."""
         table = self.read(kind, campaign, columns=["job_key"])
         return {str(k) for k in table.column("job_key").to_pylist()}
+
+
+def _latest_per_job(table: Any) -> Any:
+    """One row per job key: the one finished last (a job redone for another fingerprint, or a row
+    written twice by a retried flush, is read once: review M2, H1)."""
+    keys, finished = table.column("job_key").to_pylist(), table.column("finished").to_pylist()
+    latest: dict[str, int] = {}
+    for i, (key, when) in enumerate(zip(keys, finished, strict=True)):
+        j = latest.get(key)
+        if j is None or (when or "") >= (finished[j] or ""):
+            latest[key] = i
+    if len(latest) == len(keys):
+        return table
+    return table.take(sorted(latest.values()))

@@ -35,8 +35,18 @@ def campaign_run(
         typer.Option(help="Local worker processes, one numba thread each (default: one per core)."),
     ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="Print the summary as one JSON object.")] = False,
+    keep_stale: Annotated[
+        bool,
+        typer.Option(
+            "--keep-stale",
+            help="Keep the stored results made by another version's code, data or settings instead of redoing them.",
+        ),
+    ] = False,
 ) -> None:
     """Run the jobs of a campaign that the store does not hold yet (a rerun completes an interrupted one).
+
+    A stored result made by other code, packaged data or settings (another fingerprint) is redone,
+    unless --keep-stale; the latest result of a job is the one read.
 
     Exit status 0 when every job is done, 1 when some failed (recorded in the store's failures;
     a rerun tries them again).
@@ -51,7 +61,9 @@ def campaign_run(
     if not out.absolute().parent.is_dir():
         raise InputError(f"--out {out}: folder {out.absolute().parent} does not exist")
     with campaign_progress(campaign.name) as update:
-        summary = run_campaign(campaign, out, scheduler=scheduler, workers=workers, progress=update)
+        summary = run_campaign(
+            campaign, out, scheduler=scheduler, workers=workers, progress=update, keep_stale=keep_stale
+        )
     data = summary.to_json()
     if json_out:
         typer.echo(json.dumps(data))
@@ -60,6 +72,9 @@ def campaign_run(
         f"{summary.done} done now, {summary.failed} failed ({summary.backend}, {summary.wall_time_s:.1f} s); "
         f"store {out}"
     )
+    if summary.stale:
+        kept = "kept (--keep-stale)" if summary.kept_stale else "redone"
+        err.print(f"{summary.stale} stored result(s) were made by other code, data or settings: {kept}")
     if summary.failed:
         err.print(f"emaphm: {summary.failed} job(s) failed: see 'emaphm campaign status {spec} {out}'")
         raise typer.Exit(1)

@@ -242,6 +242,11 @@ def print_campaign_status(data: dict[str, Any]) -> None:
     table.add_row("all", *(str(data[k]) for k in ("jobs", "done", "failed", "missing")), style="bold")
     out_console = stdout_console()
     out_console.print(table)
+    if data.get("stale"):
+        out_console.print(
+            f"{data['stale']} done job(s) were made by other code, packaged data or settings "
+            "(another fingerprint): 'emaphm campaign run' redoes them, --keep-stale keeps them"
+        )
     if data["other_rows"]:
         out_console.print(
             f"{data['other_rows']} stored row(s) belong to no job of this file (an older file or version)"

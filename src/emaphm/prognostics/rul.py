@@ -230,16 +230,25 @@ def _first_failure(
     first: dict[str, Any] = {"status": "no fault tracked"}
     if estimates:
         stacked = np.vstack([e.samples for e in estimates.values()])
-        which = np.array(list(estimates))[np.argmin(stacked, axis=0)]
         est = RulEstimate.from_samples(stacked.min(axis=0), t_now)
-        names, counts = np.unique(which, return_counts=True)
         first = {
             "status": "tracked", **est.to_json(),
             "correlations": {f"{a}/{b}": round(float(rho[i, j]), 3) for i, a in enumerate(drawn)
                              for j, b in enumerate(drawn) if j > i},
             "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4),
-            "most_likely_fault": str(names[np.argmax(counts)]),
+            "most_likely_fault": most_likely_fault(list(estimates), stacked),
             "placeholder_thresholds": sorted(n for n in estimates if faults[n]["placeholder"]),
         }  # fmt: skip
         estimates["first failure"] = est
     return first
+
+
+def most_likely_fault(names: list[str], draws: np.ndarray) -> str | None:
+    """The fault that fails first in most of the draws in which one fails (rows: `names`, columns:
+    draws of its time to failure, inf: never); None when most draws never fail. Review M6: argmin
+    over a column of inf picked the first fault, counting never-failing draws as its failures."""
+    finite = np.isfinite(draws).any(axis=0)
+    if not finite.any() or finite.mean() < 0.5:
+        return None
+    first = np.argmin(draws[:, finite], axis=0)
+    return str(names[int(np.argmax(np.bincount(first, minlength=len(names))))])
