@@ -17,7 +17,7 @@ from .options import (
     ParamsOption,
     WorkersOption,
 )
-from .output import err, progress
+from .output import err, logged, progress
 
 __all__ = ["calibrate", "calibrate_detection", "calibrate_uq"]
 
@@ -103,11 +103,7 @@ def calibrate_uq(
     MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
     with numba_threads(workers, name="--workers"), progress() as update:
 
-        def report(stage: str, done: int, total: int) -> None:
-            update(stage, done, total)
-            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
-                err.print(f"{done}/{total} {stage}")
-
+        report = logged(update)
         factors = run_calibrate_uq(
             cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
             params=actuator,
@@ -143,11 +139,7 @@ def calibrate_detection(
     settings = IdentifySettings(monitor=monitor, workers=workers)  # the rest as identify's defaults
     with progress() as update:
 
-        def report(stage: str, done: int, total: int) -> None:
-            update(stage, done, total)
-            if not err.is_terminal and (done % 10 == 0 or done == total):  # a line now and then in logs
-                err.print(f"{done}/{total} {stage}")
-
+        report = logged(update)
         record = run_calibrate_detection(
             params=params, calibration=calibration, settings=settings, runs=runs, threshold_seed=seed,
             false_alarm_seed=seed + 1000, sensitivity_seed=seed + 2000 if sensitivity else None,

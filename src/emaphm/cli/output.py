@@ -14,7 +14,7 @@ from typing import Any
 
 from rich.console import Console
 
-__all__ = ["campaign_progress", "err", "progress", "status", "stdout_console"]
+__all__ = ["campaign_progress", "err", "logged", "progress", "status", "stdout_console"]
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
 
@@ -50,6 +50,18 @@ def progress() -> Iterator[Callable[[str, int, int], None]]:
             bar.update(tasks[stage], completed=done)
 
         yield update
+
+
+def logged(update: Callable[[str, int, int], None]) -> Callable[[str, int, int], None]:
+    """`update` (a `progress` bar's) that also prints a line every 10 steps when stderr is a log,
+    not a terminal (the long calibrations)."""
+
+    def report(stage: str, done: int, total: int) -> None:
+        update(stage, done, total)
+        if not err.is_terminal and (done % 10 == 0 or done == total):
+            err.print(f"{done}/{total} {stage}")
+
+    return report
 
 
 @contextmanager
