@@ -241,3 +241,22 @@ def test_bad_inputs_raise_input_error():
         emaphm.simulate(HEALTHY, model="xx")
     with pytest.raises(emaphm.InputError, match="seed"):
         emaphm.simulate(HEALTHY, seed=-3)
+
+
+def test_a_recordings_grid_is_not_kept_alive_by_the_grid_cache():
+    # review L5: the cache keyed SampledCommands by identity, so a campaign worker kept up to 32
+    # recordings' arrays alive
+    import gc
+    import weakref
+
+    from emaphm.commands import SampledCommand
+    from emaphm.models import MonitorEma
+
+    command = SampledCommand(np.linspace(0.0, 0.5, 5001), np.zeros(5001))
+    monitor = MonitorEma(command=command)
+    t, theta = monitor.sample_grid()
+    assert len(t) == 5001 and not theta.flags.writeable
+    gone = weakref.ref(command)
+    del monitor, command, t, theta
+    gc.collect()
+    assert gone() is None

@@ -457,3 +457,14 @@ def test_serial_and_dask_treat_a_jobs_programming_error_alike(tmp_path, monkeypa
     summary = run_campaign(write_spec(tmp_path), tmp_path / "store", scheduler="serial")
     failures = ResultStore(tmp_path / "store").read("failures").to_pylist()
     assert summary.failed == 12 and {f["error"] for f in failures} == {"KeyError"}
+
+
+@pytest.mark.slow  # starts a Dask cluster (~3 s)
+def test_a_cluster_whose_workers_run_several_threads_is_refused(tmp_path):
+    # review M3: two jobs in one worker process both call numba's parallel kernels
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(InputError, match=r"run 2 threads each.*--nthreads 1"):
+            run_campaign(write_spec(tmp_path), tmp_path / "store", scheduler=cluster.scheduler_address)
+    assert not (tmp_path / "store" / "results").exists()

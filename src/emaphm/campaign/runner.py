@@ -239,7 +239,7 @@ def _run_dask(
             client = Client(address, timeout="10s")
         except OSError as exc:
             raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
-        workers = max(1, len(client.scheduler_info().get("workers", {})))
+        workers = _checked_workers(client, address)
         backend = f"dask scheduler {address} ({workers} workers)"
     if cluster is not None:
         try:
@@ -276,6 +276,19 @@ def _run_dask(
             cluster.close()
         _restore_environ(environ)
     return backend, workers
+
+
+def _checked_workers(client: Any, address: str) -> int:
+    """The workers of a running cluster, each of which must run one job at a time (two jobs in one
+    process call numba's parallel kernels at once: review M3); `InputError` otherwise."""
+    threads = [int(w.get("nthreads", 1)) for w in client.scheduler_info().get("workers", {}).values()]
+    if any(n > 1 for n in threads):
+        client.close()
+        raise InputError(
+            f"the Dask workers at {address} run {max(threads)} threads each; emaphm needs one job per worker "
+            f"process: start them with 'NUMBA_NUM_THREADS=1 dask worker {address} --nthreads 1 --nworkers N'"
+        )
+    return max(1, len(threads))
 
 
 def _restore_environ(saved: dict[str, str]) -> None:

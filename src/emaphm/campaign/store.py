@@ -113,10 +113,14 @@ class ResultStore:
     # -- reading ----------------------------------------------------------------------------
 
     def read(
-        self, kind: str = "results", campaign: str | None = None, columns: Iterable[str] | None = None
+        self,
+        kind: str = "results",
+        campaign: str | None = None,
+        columns: Iterable[str] | None = None,
+        actuator: str | None = None,
     ) -> Any:
         """The ``kind`` dataset as a pyarrow Table (empty if nothing was written), optionally of
-        one campaign and some columns; `InputError` naming a part file that cannot be read."""
+        one campaign (and `actuator`) and some columns; `InputError` naming a part file that cannot be read."""
         pa, ds, _ = _pyarrow()
         base = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
         names = list(columns) if columns is not None else [*PARTITIONS, *base]
@@ -132,7 +136,11 @@ class ResultStore:
         extra = [n for n in ("job_key", "finished") if n not in names]  # what the latest row per job needs
         try:
             data = ds.dataset(folder, format="parquet", partitioning=partitioning, schema=schema)
-            filt = (ds.field("campaign") == campaign) if campaign is not None else None
+            filt = None  # the partitions asked for are the only ones read (review L5)
+            for name, value in (("campaign", campaign), ("actuator", actuator)):
+                if value is not None:
+                    term = ds.field(name) == value
+                    filt = term if filt is None else filt & term
             table = data.to_table(columns=[*names, *extra], filter=filt)
         except (pa.ArrowInvalid, OSError) as exc:
             raise InputError(f"{folder}: a part file cannot be read ({exc})".splitlines()[0]) from None

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._version import __version__
-from ..commands import Chirp, Command, command_record
+from ..commands import Chirp, Command, SampledCommand, command_record
 from ..errors import InputError, SimulationError
 from ..faults import FaultedParameters
 from ..kernels.controller import ControllerPack
@@ -75,15 +75,17 @@ def mechanics_pack(params: EmaParams, fp: FaultedParameters) -> MechanicsPack:
     return MechanicsPack(tr.J, tr.C, fp.F_S, fp.F_D, fp.B, tr.tau, tr.eta, tr.theta_max, tr.T_load)
 
 
-@functools.lru_cache(maxsize=32)
-def _sample_grid(
-    command: Command, f_s: float, duration: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _grid(command: Command, f_s: float, duration: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     t = np.arange(sample_count(duration, f_s)) / f_s
     theta_cmd = np.ascontiguousarray(command(t), dtype=np.float64)
     t.setflags(write=False)
     theta_cmd.setflags(write=False)
     return t, theta_cmd
+
+
+# the grids of the built-in commands, which are small and few; a recording's (`SampledCommand`,
+# hashed by identity) is not kept: a long-lived campaign worker kept 32 of them alive (review L5)
+_sample_grid = functools.lru_cache(maxsize=32)(_grid)
 
 
 @functools.lru_cache(maxsize=32)
@@ -103,7 +105,7 @@ class _EmaModel:
     def sample_grid(self, duration: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Sample instants t_k = k/f_s [s] over `duration` (default: the command's) and θ_cmd(t_k) [rad].
 
-        The arrays are cached and read-only.
+        The arrays are read-only, and cached for the built-in commands.
         """
         duration = float(self.command.duration if duration is None else duration)
         if not (math.isfinite(duration) and duration > 0):
@@ -117,7 +119,8 @@ class _EmaModel:
                 f"duration {duration:g} s is longer than one run can simulate: at most "
                 f"{(MAX_SAMPLES - 1) / f_s:g} s ({MAX_SAMPLES - 1} samples at {f_s:g} Hz)"
             )
-        return _sample_grid(self.command, self.params.controller.f_s, duration)  # type: ignore[arg-type]
+        grid = _grid if isinstance(self.command, SampledCommand) else _sample_grid
+        return grid(self.command, self.params.controller.f_s, duration)
 
     def metadata(
         self, k: NDArray[np.float64], seed: int, noise: bool, t: NDArray[np.float64], **extra: Any

@@ -40,7 +40,7 @@ def history(
     """The actuator's rows of a results store, sorted by flight (one-off measurements, flight 0, left out)."""
     from ..campaign.store import ResultStore
 
-    rows = [r for r in ResultStore(store).read("results", campaign).to_pylist() if r["actuator"] == actuator]
+    rows = ResultStore(store).read("results", campaign, actuator=actuator).to_pylist()
     if not rows:
         raise InputError(
             f"{store}: no results for actuator {actuator!r}"
