@@ -451,3 +451,27 @@ def test_calibrate_detection_writes_thresholds_identify_can_load(tmp_path, capsy
     code, _, err = run_cli(["calibrate-detection", "--runs", "0", "--output", str(tmp_path / "no.json")], capsys)
     assert code == 2 and "runs must be" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "no.json").exists()
+
+
+@pytest.mark.slow  # a tiny calibration and identification of another actuator, ~3 s
+def test_an_8_khz_actuator_identifies_from_the_shell_with_the_switching_last_stage(tmp_path, capsys, monkeypatch):
+    # review M1: fixed 2, 2.5, 1.25 us switching steps refused an 8 kHz actuator after the whole search
+    import json
+
+    from emaphm.identification import limits
+
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
+    actuator = tmp_path / "act8k.toml"
+    actuator.write_text('[controller]\nf_s = "8 kHz"\n')
+    cal = tmp_path / "cal8k.json"
+    code, _, _ = run_cli(["calibrate", "--params", str(actuator), "--pop-size", "4", "--generations", "1",
+                          "--output", str(cal)], capsys)  # fmt: skip
+    assert code == 0
+    code, out, _ = run_cli(["identify", "--params", str(actuator), "--calibration", str(cal), "--true-faults",
+                              "0.2,0,0,0.3,0,0,0,0.5", "--pop-size", "8", "--generations", "2",
+                              "--uncertainty", "none", "--json"], capsys)  # fmt: skip
+    data = json.loads(out)
+    switching = next(r for r in data["settings"]["stages"] if r["stage"] == "last_stage")["switching"]
+    assert code in (0, 3) and data["settings"]["last_stage"] == "switching"
+    for step in switching["steps_s"]:  # whole fractions of the 125 us sample period
+        assert 125e-6 / step == pytest.approx(round(125e-6 / step), abs=1e-9)
