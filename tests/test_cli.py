@@ -292,14 +292,14 @@ def test_identify_says_what_the_switching_last_stage_did(capsys, monkeypatch):
     stdout = " ".join(stdout.split())  # the console wraps long lines
     code_json, json_out, _ = run_cli([*args, "--json"], capsys)
     data = json.loads(json_out)
-    stage = stage_record(data["settings"], "last_stage")["switching"]
+    stage = stage_record(data["settings"]["stages"], "last_stage")["switching"]
     assert code == code_json == 0 and data["settings"]["last_stage"] == "switching"
     assert f"switching last stage: the switching model's eq. 3 {stage['start_fitness']:.4g}" in stdout
     assert ("iterate" in stdout) == stage["taken"]
     assert data["fitness"] == pytest.approx(stage["fitness"], rel=1e-6)
     code, json_out, _ = run_cli([*args, "--json", "--last-stage", "none"], capsys)
     settings = json.loads(json_out)["settings"]
-    assert code == 0 and settings["last_stage"] == "none" and stage_record(settings, "last_stage")["switching"] is None
+    assert code == 0 and settings["last_stage"] == "none" and stage_record(settings["stages"], "last_stage")["switching"] is None
     # the same search either way: the monitor's fitness at the search's estimate
     assert settings["search_fitness"] == data["settings"]["search_fitness"]
 
@@ -320,14 +320,14 @@ def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, mon
     stdout = " ".join(stdout.split())  # the console wraps long lines
     assert code == 0 and "second search: the first fit's NRMSE " in stdout and "x the first: " in stdout
     code, json_out, _ = run_cli([*args, "--json"], capsys)
-    record = stage_record(json.loads(json_out)["settings"], "second_search")
+    record = stage_record(json.loads(json_out)["settings"]["stages"], "second_search")
     assert code == 0 and record["trigger"] == 0.0 and record["first_fit_nrmse"] > 0.0
     # the line says which result was kept, as the record does
     kept = "its result kept" if record["taken"] else "the first search's result kept"
     assert kept in stdout
     code, stdout, _ = run_cli([*args, "--json", "--no-second-search"], capsys)
     data = json.loads(stdout)
-    assert stage_record(data["settings"], "second_search") == {"stage": "second_search", "enabled": False, "ran": False}
+    assert stage_record(data["settings"]["stages"], "second_search") == {"stage": "second_search", "enabled": False, "ran": False}
     code, stdout, _ = run_cli([*args, "--no-second-search"], capsys)
     assert "second search" not in stdout
 

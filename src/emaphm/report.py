@@ -207,5 +207,5 @@ def _fit_model(data: dict[str, Any]) -> str:
     that ran (`FaultIdentifier.curves`), else the LF monitor's."""
     from .identification.result import stage_record
 
-    stage = (stage_record(data["settings"], "last_stage") or {}).get("switching")
+    stage = (stage_record(data["settings"].get("stages", []), "last_stage") or {}).get("switching")
     return "switching model" if stage is not None and "error" not in stage else "LF model"

@@ -39,10 +39,10 @@ def print_identification(data: dict[str, Any]) -> None:
         )
     from ..identification.result import stage_record
 
-    second = stage_record(data["settings"], "second_search")
+    second = stage_record(data["settings"].get("stages", []), "second_search")
     if second is not None and second["ran"]:
         out.print(_second_search_line(second))
-    stage = (stage_record(data["settings"], "last_stage") or {}).get("switching")
+    stage = (stage_record(data["settings"].get("stages", []), "last_stage") or {}).get("switching")
     if stage is not None:
         out.print(_switching_stage_line(stage))
     if data["verdict"] != "fits":

@@ -30,7 +30,7 @@ from .optimizers import OnGeneration
 from .problem import search_to_faults
 from .second_search import second_search
 from .settings import IdentifySettings
-from .state import Record, Stage
+from .state import Record, Stage, stage_record
 
 __all__ = ["AFTER_SEARCH", "FaultIdentifier"]
 
@@ -120,12 +120,8 @@ class FaultIdentifier:
 
     def record(self, stage: str) -> Record | None:
         """The record of `stage` (its name: "search", "polish", "final_checks", "least_squares",
-        "fit", "second_search", "last_stage"), the kept search's for the search's stages."""
-        found = [r for r in self.records_ if r["stage"] == stage]
-        second = self.record("second_search") if stage not in ("second_search", "last_stage") else None
-        if second is not None and second.get("taken"):
-            found = [r for r in second["stages"] if r["stage"] == stage]
-        return found[-1] if found else None
+        "fit", "second_search", "last_stage"), the kept search's for the search's stages (`state.stage_record`)."""
+        return stage_record(self.records_, stage)
 
     def residuals(self, objective: Any = None) -> Any:
         """Eq. 3's residual vectors for rows of the search box (`context.Context.residuals`)."""

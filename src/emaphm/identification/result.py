@@ -18,17 +18,11 @@ from numpy.typing import NDArray
 from .._version import __version__
 from ..faults import FAULT_NAMES
 from .metrics import absolute_errors, percent_error
+from .state import stage_record
 from .uncertainty import Uncertainty
 from .verdict import explains
 
 __all__ = ["IdentificationResult", "stage_record"]
-
-
-def stage_record(settings: dict[str, Any], name: str) -> dict[str, Any] | None:
-    """The record of stage `name` in a result's settings (a dict or its JSON), the last one of
-    that name when it ran more than once (the second search's own stages are inside its record)."""
-    found = [r for r in settings.get("stages", []) if r.get("stage") == name]
-    return found[-1] if found else None
 
 
 @dataclass(frozen=True)
@@ -87,7 +81,7 @@ class IdentificationResult:
     def stage(self, name: str) -> dict[str, Any] | None:
         """The record of the stage `name` ("search", "polish", "final_checks", "least_squares",
         "fit", "second_search", "last_stage"; `stage_record`), None if it is not in the result."""
-        return stage_record(self.settings, name)
+        return stage_record(self.settings.get("stages", []), name)
 
     @property
     def percent_error(self) -> float | None:

@@ -163,27 +163,16 @@ class IdentifySettings:
         base = settings if settings is not None else cls()
         if not isinstance(base, IdentifySettings):
             raise InputError(f"settings must be an IdentifySettings, got {type(base).__name__}")
-        return (
-            type(base).from_mapping({**base.to_json(), **options}, where="identification options")
-            if options
-            else base
-        )
+        return base.replace(**options) if options else base
 
     def replace(self, **changes: Any) -> IdentifySettings:
         """A copy with `changes` (checked); an unknown name raises `InputError`."""
-        return type(self).from_mapping({**self.to_json(), **changes}, where="settings")
+        return type(self).from_mapping({**self.to_json(), **changes}, where="identification options")
 
     def to_json(self) -> dict[str, Any]:
         """The fields as JSON values (the error corner's None stays None: 'off')."""
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
-    def non_default(self) -> dict[str, Any]:
-        """The fields that differ from their defaults (what a campaign's job key hashes)."""
-        return {
-            f.name: getattr(self, f.name)
-            for f in dataclasses.fields(self)
-            if getattr(self, f.name) != f.default
-        }
 
 
 def _check_int(name: str, value: Any, low: int, high: int, what: str, *, none: bool = False) -> None:

@@ -22,7 +22,7 @@ from .optimizers import OptimizerRun
 if TYPE_CHECKING:
     from .context import Context
 
-__all__ = ["Record", "Stage", "State", "finite"]
+__all__ = ["Record", "Stage", "State", "finite", "stage_record"]
 
 Record = dict[str, Any]
 
@@ -61,6 +61,18 @@ class State:
 
 
 Stage = Callable[["State | None", "Context"], tuple[State, Record]]
+
+
+def stage_record(stages: list[Record], name: str) -> Record | None:
+    """The record of stage `name` among `stages` (`FaultIdentifier.records_`, a result's
+    ``settings["stages"]`` or its JSON); for the search's own stages, the kept search's: the
+    second search's, inside its record, when it was taken. None if `name` did not run."""
+    found = [r for r in stages if r.get("stage") == name]
+    if name not in ("second_search", "last_stage"):
+        second = stage_record(stages, "second_search")
+        if second is not None and second.get("taken"):
+            found = [r for r in second["stages"] if r.get("stage") == name]
+    return found[-1] if found else None
 
 
 def finite(value: float, digits: int = 6) -> float | None:
