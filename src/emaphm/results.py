@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from .errors import InputError
 
-__all__ = ["REQUIRED_SIGNALS", "UNITS", "SimResult"]
+__all__ = ["REQUIRED_SIGNALS", "UNITS", "SimResult", "check_time_axis"]
 
 UNITS: dict[str, str] = {
     "t": "s",
@@ -32,6 +32,15 @@ UNITS: dict[str, str] = {
 REQUIRED_SIGNALS = ("t", "theta_cmd", "i_q")
 
 
+def check_time_axis(t: Any, what: str = "the time axis") -> None:
+    """`InputError` naming the first sample of `t` that does not follow the one before it: the
+    times must increase strictly (`np.interp` and the filters need it; review L1)."""
+    steps = np.diff(np.asarray(t, dtype=np.float64))
+    if len(steps) and not np.all(steps > 0):
+        row = int(np.flatnonzero(~(steps > 0))[0]) + 1
+        raise InputError(f"{what} must increase strictly; sample {row} is at or before the one before it")
+
+
 @dataclass(frozen=True)
 class SimResult:
     """Signals on the sample grid t (SI units, see `UNITS`) and the metadata that produced them.
@@ -50,10 +59,7 @@ class SimResult:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        steps = np.diff(np.asarray(self.t, dtype=np.float64))
-        if len(steps) and not np.all(steps > 0):  # np.interp and the filters need it (review L1)
-            row = int(np.flatnonzero(~(steps > 0))[0]) + 1
-            raise InputError(f"the time axis must increase strictly; sample {row} is at or before the one before it")
+        check_time_axis(self.t)
         for name, values in self.signals.items():
             if values.shape != self.t.shape:
                 raise ValueError(f"signal {name!r} has shape {values.shape}, t has {self.t.shape}")

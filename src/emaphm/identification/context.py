@@ -18,6 +18,7 @@ from ..commands import Command
 from ..errors import InputError, SimulationError
 from ..kernels.monitor import RING_OUTER
 from ..models import MonitorEma
+from ..results import check_time_axis
 from . import limits
 from .fitness import Fitness
 from .optimizers import OnGeneration
@@ -26,7 +27,7 @@ from .settings import IdentifySettings
 from .signals import Comparison, nrmse
 from .weights import BAND_HZ, REST_SETTLE_S, band_mask, error_weights, moving_mask, resolve_error_corner
 
-__all__ = ["Context", "check_time_axis", "prepare"]
+__all__ = ["Context", "prepare"]
 
 
 @dataclass(frozen=True)
@@ -103,18 +104,6 @@ class Context:
         return {"t": shown.t, "measured": shown.reference, "fitted": out, "compared": compared}
 
 
-def check_time_axis(t: NDArray[np.float64], what: str = "the reference") -> None:
-    """`InputError` unless the times are finite and strictly increasing (`np.interp` needs it)."""
-    if not np.all(np.isfinite(t)):
-        raise InputError(f"{what} contains NaN or inf")
-    steps = np.diff(t)
-    if len(steps) and not np.all(steps > 0):
-        row = int(np.flatnonzero(~(steps > 0))[0]) + 1
-        raise InputError(
-            f"{what}'s time axis must increase strictly; sample {row} is at or before the one before it"
-        )
-
-
 def _checked(t: ArrayLike, i_q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     t, i_q = np.asarray(t, dtype=np.float64), np.asarray(i_q, dtype=np.float64)
     if t.ndim != 1 or t.shape != i_q.shape:
@@ -123,7 +112,7 @@ def _checked(t: ArrayLike, i_q: ArrayLike) -> tuple[NDArray[np.float64], NDArray
         raise InputError(f"the reference has {len(t)} samples; at least {limits.MIN_SAMPLES} are needed")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(i_q))):
         raise InputError("the reference contains NaN or inf")
-    check_time_axis(t)
+    check_time_axis(t, "the reference's time axis")
     span = float(t[-1] - t[0])
     if span > limits.MAX_SPAN:
         raise InputError(

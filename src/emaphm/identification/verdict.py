@@ -44,7 +44,7 @@ def recording_warnings(
     if context.above_band > 0:
         warnings.append(
             f"{100 * context.above_band:.0f} % of the recording commands motion faster than the "
-            f"{_band_hz():g} Hz the monitor was fitted on; it is left out of the comparison (docs/identification.md §3)"
+            f"{limits.BAND_HZ:g} Hz the monitor was fitted on; it is left out of the comparison (docs/identification.md §3)"
         )
     if context.compared < limits.MIN_COMPARED:
         warnings.append(
@@ -59,12 +59,6 @@ def recording_warnings(
             f"{context.monitor.monitor!r} one: faults near them may be reported wrongly"
         )
     return warnings
-
-
-def _band_hz() -> float:
-    from .weights import BAND_HZ
-
-    return BAND_HZ
 
 
 def fit_warnings(fit_nrmse: float) -> list[str]:
