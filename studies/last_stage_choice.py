@@ -2,18 +2,22 @@
 # figures are in the commit message and the issue's closing note (24 chirp cases of seed 6061).
 """Which iterate the switching last stage should keep: rules compared on the same iterates.
 
-    python studies/last_stage_choice.py [--cases 24] [--case-seed 6061] [--seeds 1]
+    python studies/last_stage_choice.py [--cases 24] [--case-seed 6061] [--seeds 1] [--tolerance 0.02]
 
 Each random case (DESIGN §7 ranges, `random_faults(cases, case-seed)`) is measured by the twin as
 ``emaphm identify --true-faults K --seed S`` measures it and identified with the defaults; the
 last stage's iterates are captured and each rule's choice scored by %err: the switching model's
 eq. 3 alone (the rule before review L3), its sum with the corrected monitor's under the last
 correction (the rule now), the corrected monitor's alone, the last iterate, the search's estimate.
+With --tolerance T the twin of each case is an actuator the monitor was not calibrated for: R_s,
+L_s, psi_m, J_m, J_u, F_S0 and F_D0 each drawn uniformly within ±T of nominal (seeded by the case),
+identified with the nominal actuator and its packaged calibration.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import statistics
 
 import numpy as np
@@ -28,11 +32,27 @@ def noise_seed_of(seed: int) -> int:
     return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
 
 
+def toleranced(tolerance: float, seed: int) -> emaphm.EmaParams:
+    """The nominal actuator with its constants each within ±`tolerance` (a drawn unit)."""
+    rng = np.random.default_rng(seed)
+    base = emaphm.EmaParams()
+
+    def scaled(group: object, names: tuple[str, ...]) -> object:
+        return dataclasses.replace(group, **{n: getattr(group, n) * (1 + rng.uniform(-tolerance, tolerance)) for n in names})
+
+    return dataclasses.replace(
+        base,
+        motor=scaled(base.motor, ("R_s", "L_s", "psi_m")),
+        transmission=scaled(base.transmission, ("J_m", "J_u", "F_S0", "F_D0")),
+    )
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=24)
     parser.add_argument("--case-seed", type=int, default=6061)
     parser.add_argument("--seeds", type=int, default=1)
+    parser.add_argument("--tolerance", type=float, default=0.0, help="draw each twin within ±T of nominal")
     args = parser.parse_args(argv)
     captured = []
     original = last_stage.space_mapping
@@ -55,6 +75,8 @@ def main(argv: list[str] | None = None) -> None:
     for c, k in enumerate(random_faults(args.cases, args.case_seed)):
         for s in range(1, args.seeds + 1):
             captured.clear()
+            if args.tolerance > 0:
+                twin = emaphm.HighFidelityEma(toleranced(args.tolerance, 1000 * args.case_seed + c))
             trace = twin.simulate(k, noise=True, seed=noise_seed_of(s))
             emaphm.identify(reference=trace, seed=s, uncertainty="none")
             if not captured:
