@@ -36,6 +36,7 @@ from emaphm.identification.problem import search_to_faults
 from emaphm.identification.settings import IdentifySettings
 from emaphm.identification.uncertainty import covers, laplace, load_factors
 from emaphm.kernels.monitor import N_AUX, simulate_lf, simulate_lf_many
+from emaphm.tolerances import drawn_actuator
 
 __all__ = [
     "CALIBRATION_COMMANDS",
@@ -51,6 +52,7 @@ __all__ = [
     "budget_text",
     "covers",
     "draw_cases",
+    "drawn_actuator",
     "laplace",
     "load_factors",
     "load_params",

@@ -2,10 +2,16 @@
 
 Target ≤ 0.15 s, goal ≤ 0.05 s. Reported in BENCHMARKS.md, "HF twin speed". Run:
 
-    python benchmarks/bench_hf.py [--repeats 5]
-    python benchmarks/bench_hf.py --batch 40 [--repeats 5]
+    python benchmarks/bench_hf.py [--repeats 5] [--control foc]
+    python benchmarks/bench_hf.py --batch 40 [--repeats 5] [--control foc]
 
-Smallest run (the smoke test): ``--repeats 1`` and ``--batch 2 --repeats 1``.
+Smallest run (the smoke test): ``--repeats 1``, ``--batch 2 --repeats 1`` and
+``--control foc --repeats 1``.
+
+--control chooses the drive of the twin: "hysteresis" (the paper's comparators, the default) or
+"foc" (field-oriented control with PWM, `InverterParams(control="foc")` with its default
+settings: 20 kHz, single update, one period's delay, svpwm, 1 µs dead time compensated). The
+machine line names it; the table is the same.
 
 The first call loads (or compiles) the numba kernels and is reported apart; the figure is the
 median over the repeats of each case, on the default FDI chirp (1 s simulated, Δt = 1 µs), and
@@ -31,6 +37,7 @@ import numpy as np
 from _cases import draw_cases, machine_line  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
+from emaphm.params import CONTROL_MODES, InverterParams
 
 CASES = {
     "healthy": emaphm.HEALTHY,
@@ -43,15 +50,19 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--batch", type=int, default=0, help="N: time a batch of N runs on 1 and 2 threads")
+    parser.add_argument(
+        "--control", choices=CONTROL_MODES, default="hysteresis", help="the twin's current control (drive)"
+    )
     args = parser.parse_args(argv)
+    params = twin_params(args.control)
     if args.batch:
-        batch(args)
+        batch(args, params)
         return
 
     t0 = time.perf_counter()
-    emaphm.simulate(emaphm.HEALTHY, duration=0.01)
+    emaphm.simulate(emaphm.HEALTHY, duration=0.01, params=params)
     first = time.perf_counter() - t0
-    print(machine_line(f"NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}"))
+    print(machine_line(f"NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}, control={args.control}"))
     print(f"first call (import of kernels: compile or cache load): {first:.2f} s")
     dt = emaphm.EmaParams().integration.dt
     print(
@@ -64,7 +75,7 @@ def main(argv: list[str] | None = None) -> None:
         for seed in range(args.repeats):
             t0 = time.perf_counter()
             c0 = time.process_time()
-            r = emaphm.simulate(k, seed=seed)
+            r = emaphm.simulate(k, seed=seed, params=params)
             cpus.append(time.process_time() - c0)
             walls.append(time.perf_counter() - t0)
         sim_s = float(r.t[-1])
@@ -76,14 +87,20 @@ def main(argv: list[str] | None = None) -> None:
         )
 
 
-def batch(args: argparse.Namespace) -> None:
+def twin_params(control: str) -> emaphm.EmaParams:
+    """The nominal parameters with the current control `control` (its defaults)."""
+    return emaphm.EmaParams(inverter=InverterParams(control=control))
+
+
+def batch(args: argparse.Namespace, params: emaphm.EmaParams) -> None:
     """`simulate_batch` of args.batch random rows on 1 thread and on 2, alternating."""
     K = draw_cases(args.batch, 9002)
-    twin = emaphm.HighFidelityEma()
+    twin = emaphm.HighFidelityEma(params)
     twin.simulate_batch(K[:2], noise=False, workers=2)  # compile or cache load
     print(
         machine_line(
-            f"simulate_batch of {args.batch} random rows (seed 9002), noise off, {args.repeats} rounds"
+            f"simulate_batch of {args.batch} random rows (seed 9002), noise off, {args.repeats} rounds, "
+            f"control={args.control}"
         )
     )
     walls: dict[int, list[float]] = {1: [], 2: []}

@@ -17,7 +17,11 @@ STUDIES = sorted((ROOT / "studies").glob("*.py"))
 TINY = ["--pop-size", "4", "--generations", "1", "--no-polish"]  # an identification of ~0.1 s
 
 SMALLEST = {
-    "bench_hf": [["--repeats", "1"], ["--batch", "2", "--repeats", "1"]],
+    "bench_hf": [
+        ["--repeats", "1"],
+        ["--batch", "2", "--repeats", "1"],
+        ["--control", "foc", "--repeats", "1"],
+    ],
     "bench_lf": [["--repeats", "1", "--population", "4", "--evaluate", "4", "--rounds", "1"]],
     "bench_identify": [
         [
@@ -36,6 +40,7 @@ SMALLEST = {
     ],
     "bench_multifault": [["--cases", "1", "--seeds", "1", "--restarts", "1", "--last-stage", "none", *TINY]],
     "monitor_fidelity": [["--cases", "1", "--commands", "chirp"]],
+    "bench_foc": [["--cases", "1", "--seeds", "1", "--healthy", "0", "--last-stage", "none", *TINY]],
     "uq_coverage": [["--cases", "2", "--healthy", "1", *TINY]],
     "bench_reader": [["--cases", "1", *TINY]],
     "bench_campaign": [["--jobs", "2", "--tiny", "2", *TINY]],

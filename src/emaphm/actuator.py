@@ -7,6 +7,12 @@ unit and meaning as a comment. ``--params FILE`` (``params=`` in the API) reads 
 
 - a value is a number in the SI unit of the comment, or a string with a unit from the closed
   table of `emaphm.units`: ``L_s = "1.5 mH"``, ``theta_max = "28.6 deg"``, ``I_max = "10000 mA"``;
+  a choice is a string taken as it is (``control = "foc"``, ``modulation = "sine"``), a flag is
+  ``true`` or ``false``;
+- ``[inverter] control`` chooses the drive: ``"hysteresis"`` (the paper's, the default) or
+  ``"foc"`` (field-oriented control with PWM); the keys of the other mode (`MODE_KEYS`: ``h`` for
+  hysteresis, ``f_pwm``, ``K_p_i``, ... for FOC) are refused, and the template writes the FOC keys
+  commented out under a hysteresis drive;
 - a parameter left out keeps the paper's nominal value; a key may also stand at the top level
   (``R_s = 0.6``) and is then found in its block;
 - unknown tables or keys, a unit of another kind (``R_s = "1 mH"``), a value that fails its
@@ -25,7 +31,7 @@ from typing import Any
 
 from .errors import InputError
 from .failure import parse_thresholds
-from .params import EmaParams
+from .params import MODE_KEYS, EmaParams
 from .units import parameter_units, to_si
 
 __all__ = [
@@ -42,6 +48,8 @@ __all__ = [
 ACCEPTED: dict[str, tuple[float, float]] = {
     "p": (1, 50), "R_s": (1e-3, 100.0), "L_s": (1e-6, 0.5), "psi_m": (1e-4, 2.0),
     "V_dc": (5.0, 1000.0), "h": (1e-3, 10.0),
+    "f_pwm": (1e3, 2e5), "dead_time": (0.0, 2e-5), "K_p_i": (1e-3, 1e4), "K_i_i": (0.0, 1e8),
+    "computation_delay": (0, 2), "voltage_limit": (0.1, 1.0), "pwm_phase": (0.0, 1.0),
     "J_m": (1e-8, 1.0), "J_u": (1e-6, 1e4), "tau": (1.0, 1e4), "eta": (0.05, 1.0), "C": (0.0, 1.0),
     "F_S0": (0.0, 100.0), "F_D0": (0.0, 100.0), "B0": (0.0, 0.05), "theta_max": (0.01, 3.2),
     "T_load": (0.0, 1e5),
@@ -66,39 +74,20 @@ def _fields() -> dict[str, tuple[str, dataclasses.Field[Any]]]:
 def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaParams:
     """`EmaParams` from the parsed TOML of an actuator file (see the module docstring)."""
     groups, fields = _groups(), _fields()
-    values: dict[str, dict[str, Any]] = {g: {} for g in groups}
+    raws: dict[str, Any] = {}  # key -> its raw value, in the order of the file
     seen: dict[str, str] = {}
 
-    def take(key: str, raw: Any, block: str | None) -> None:
+    def place(key: str, raw: Any, block: str | None) -> None:
         if key not in fields:
             inside = f"[{block}] " if block else ""
             raise InputError(f"{where}: unknown parameter {inside}{key!r}; see 'emaphm params --template'")
-        group, f = fields[key]
+        group, _ = fields[key]
         if block is not None and block != group:
             raise InputError(f"{where}: {key} belongs in [{group}], not in [{block}]")
         if key in seen:
             raise InputError(f"{where}: {key} is given twice ({seen[key]} and {block or 'top level'})")
         seen[key] = block or "top level"
-        si_unit = f.metadata["unit"]
-        value = to_si(raw, key, si_unit, where)
-        lo, hi = ACCEPTED[key]
-        if not (isinstance(value, (int, float)) and math.isfinite(value)):
-            raise InputError(f"{where}: {key} must be a finite number, got {raw!r}")
-        if not lo <= value <= hi:
-            hint = (
-                f': is it in another unit? write the unit, e.g. {key} = "{raw} {_example_unit(si_unit)}"'
-                if si_unit not in ("-", "bit")
-                else ""
-            )
-            raise InputError(
-                f"{where}: {key} = {raw!r} is outside the range emaphm accepts, {lo:g} to {hi:g} {si_unit}{hint}"
-            )
-        # the field's own type, so that 48, 48.0 and "48 V" are one actuator (one params_hash)
-        values[group][key] = (
-            int(value)
-            if isinstance(f.default, int) and float(value).is_integer()
-            else (value if isinstance(f.default, int) else float(value))
-        )
+        raws[key] = raw
 
     for key, raw in data.items():
         if key == "thresholds":  # the failure thresholds of prognostics: `load_thresholds`
@@ -107,20 +96,79 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
             if key not in groups:
                 raise InputError(f"{where}: unknown table [{key}]; the tables are {', '.join(groups)}")
             for name, item in raw.items():
-                take(name, item, key)
+                place(name, item, key)
         else:
-            take(key, raw, None)
+            place(key, raw, None)
+
+    # the drive first: the other mode's keys are refused before their values are read
+    control = _value("control", raws["control"], fields["control"][1], where) if "control" in raws else None
+    _check_mode(control or "hysteresis", raws, where)
+    values: dict[str, dict[str, Any]] = {g: {} for g in groups}
+    for key, raw in raws.items():
+        group, f = fields[key]
+        values[group][key] = _value(key, raw, f, where)
     try:
         return EmaParams(**{g: groups[g](**v) for g, v in values.items()})
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
 
 
-# the unit a value out of range was most likely meant in, for the hint
+def _check_mode(control: str, raws: dict[str, Any], where: str) -> None:
+    """`InputError` for a key of `raws` that belongs to a control mode other than `control`."""
+    for mode, keys in MODE_KEYS.items():
+        if mode == control:
+            continue
+        for key in keys:
+            if key in raws:
+                raise InputError(
+                    f'{where}: [inverter] {key} belongs to control = "{mode}", '
+                    f'but this file\'s control is "{control}"'
+                )
+
+
+def _value(key: str, raw: Any, f: dataclasses.Field[Any], where: str) -> Any:
+    """The value of one entry in its field's type: a choice as it is, a flag as it is, a number in
+    SI (`to_si`) checked against `ACCEPTED`; `InputError` naming `where` and `key` otherwise."""
+    check = f.metadata["check"]
+    if check == "choice":
+        choices = f.metadata["choices"]
+        if not isinstance(raw, str) or raw not in choices:
+            allowed = ", ".join(f'"{c}"' for c in choices)
+            raise InputError(f"{where}: {key} must be one of {allowed}, got {raw!r}")
+        return raw
+    if check == "flag":
+        if not isinstance(raw, bool):
+            raise InputError(f"{where}: {key} must be true or false, got {raw!r}")
+        return raw
+    si_unit = f.metadata["unit"]
+    value = to_si(raw, key, si_unit, where)
+    lo, hi = ACCEPTED[key]
+    if not (isinstance(value, (int, float)) and math.isfinite(value)):
+        raise InputError(f"{where}: {key} must be a finite number, got {raw!r}")
+    if not lo <= value <= hi:
+        likely = _example_unit(si_unit, key)
+        hint = (
+            f': is it in another unit? write the unit, e.g. {key} = "{raw} {likely}"'
+            if si_unit not in ("-", "bit") and likely != si_unit
+            else ""
+        )
+        raise InputError(
+            f"{where}: {key} = {raw!r} is outside the range emaphm accepts, {lo:g} to {hi:g} {si_unit}{hint}"
+        )
+    # the field's own type, so that 48, 48.0 and "48 V" are one actuator (one params_hash)
+    if isinstance(f.default, int):
+        return int(value) if float(value).is_integer() else value
+    return float(value)
+
+
+# the unit a value out of range was most likely meant in, for the hint (by key, then by SI unit)
+_LIKELY_FOR_KEY = {"dead_time": "us"}
 _LIKELY = {"rad": "deg", "A/rad": "A/deg", "A/(rad·s)": "A/(deg·s)", "A·s/rad": "A·s/deg"}
 
 
-def _example_unit(si_unit: str) -> str:
+def _example_unit(si_unit: str, key: str = "") -> str:
+    if key in _LIKELY_FOR_KEY:
+        return _LIKELY_FOR_KEY[key]
     if si_unit in _LIKELY:
         return _LIKELY[si_unit]
     others = [u for u in parameter_units(si_unit) if u != si_unit]
@@ -151,8 +199,13 @@ def resolve_params(params: EmaParams | str | os.PathLike[str] | None) -> EmaPara
     raise InputError(f"params must be EmaParams or the path of an actuator file, got {type(params).__name__}")
 
 
-def _toml_number(value: float | int) -> str:
-    if isinstance(value, int) and not isinstance(value, bool):
+def _toml_value(value: Any) -> str:
+    """A parameter value as TOML: a flag as true/false, a choice quoted, a number as it is."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, int):
         return str(value)
     text = repr(float(value))
     return text if any(c in text for c in ".en") else text + ".0"
@@ -160,7 +213,12 @@ def _toml_number(value: float | int) -> str:
 
 def params_template(params: EmaParams | None = None) -> str:
     """A complete actuator file (TOML) with the values of `params` (default: nominal), every key
-    with its unit and meaning as a comment."""
+    with its unit and meaning as a comment.
+
+    The ``[inverter]`` table holds the keys of `params`' control mode; under a hysteresis drive
+    the FOC keys follow commented out (their defaults), so the file is valid as it is and shows
+    every key.
+    """
     params = params if params is not None else EmaParams()
     lines = [
         "# emaphm actuator file: every parameter of the EMA (DESIGN §7), one table per block.",
@@ -172,12 +230,20 @@ def params_template(params: EmaParams | None = None) -> str:
     for group, cls in _groups().items():
         lines += ["", f"[{group}]  # {(cls.__doc__ or '').strip().splitlines()[0]}"]
         instance = getattr(params, group)
-        entries = [
-            (f.name, _toml_number(getattr(instance, f.name)), f.metadata) for f in dataclasses.fields(cls)
-        ]
-        width = max(len(n) + len(v) + 3 for n, v, _ in entries)
-        for name, value, meta in entries:
-            lines.append(f"{name} = {value}".ljust(width) + f"  # [{meta['unit']}] {meta['doc']}")
+        meta = {f.name: f.metadata for f in dataclasses.fields(cls)}
+        entries = [(name, _toml_value(getattr(instance, name)), "") for name in instance.fields_in_use()]
+        extra = ""
+        if group == "inverter" and instance.control == "hysteresis":
+            extra = '# field-oriented control: set control = "foc", remove h and uncomment these'
+            default = type(instance)(control="foc")
+            entries += [(name, _toml_value(getattr(default, name)), "# ") for name in MODE_KEYS["foc"]]
+        width = max(len(p) + len(n) + len(v) + 3 for n, v, p in entries)
+        for name, value, prefix in entries:
+            if prefix and extra:
+                lines.append(extra)
+                extra = ""
+            text = f"{prefix}{name} = {value}".ljust(width)
+            lines.append(text + f"  # [{meta[name]['unit']}] {meta[name]['doc']}")
     return "\n".join(lines) + "\n"
 
 

@@ -4,22 +4,29 @@ Every field carries its symbol, unit and meaning in the field metadata; the docu
 parameter table is generated from that metadata (`parameter_table_markdown`), so the two cannot
 drift. All values are SI.
 
-The groups mirror the block diagram: `MotorParams` (PMSM), `InverterParams` (hysteresis
-inverter), `TransmissionParams` (gearbox, friction, backlash, end-stops), `ControllerParams` (ACE
-position loop), `SensorParams` (ADC and noise), `IntegrationParams` (fixed-step solver), bundled
-in `EmaParams`.
+The groups mirror the block diagram: `MotorParams` (PMSM), `InverterParams` (the drive:
+hysteresis current control or field-oriented control with PWM), `TransmissionParams` (gearbox,
+friction, backlash, end-stops), `ControllerParams` (ACE position loop), `SensorParams` (ADC and
+noise), `IntegrationParams` (fixed-step solver), bundled in `EmaParams`.
+
+The field-metadata mechanism (`_p`, `_choice`, `_flag`, `_Validated`) is `emaphm._fields`;
+`InverterParams` and the keys of each control mode (`MODE_KEYS`) are `emaphm.drive`, re-exported
+here.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from ._fields import _p, _Validated, format_value
+from .drive import CONTROL_MODES, MODE_KEYS, InverterParams
 from .errors import InputError
 
 __all__ = [
+    "CONTROL_MODES",
+    "MODE_KEYS",
     "ControllerParams",
     "EmaParams",
     "IntegrationParams",
@@ -29,38 +36,6 @@ __all__ = [
     "TransmissionParams",
     "parameter_table_markdown",
 ]
-
-_CHECKS = {
-    "positive": (lambda v: v > 0, "must be > 0"),
-    "nonnegative": (lambda v: v >= 0, "must be >= 0"),
-    "fraction": (lambda v: 0 < v <= 1, "must be in (0, 1]"),
-}
-
-
-def _p(default: float, symbol: str, unit: str, doc: str, check: str = "positive") -> Any:
-    """A dataclass field with its symbol, unit, meaning and validity check in the metadata."""
-    return field(default=default, metadata={"symbol": symbol, "unit": unit, "doc": doc, "check": check})
-
-
-class _Validated:
-    """Checks every field against its metadata on construction (finite, and its `check`)."""
-
-    def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
-            value = getattr(self, f.name)
-            if isinstance(value, _Validated):
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise InputError(f"{type(self).__name__}.{f.name} must be a number, got {value!r}")
-            if not math.isfinite(value):
-                raise InputError(f"{type(self).__name__}.{f.name} must be finite, got {value!r}")
-            ok, what = _CHECKS[f.metadata["check"]]
-            if not ok(value):
-                raise InputError(f"{type(self).__name__}.{f.name} {what}, got {value!r}")
-        self._check()
-
-    def _check(self) -> None:
-        """Cross-field checks of a group (overridden where needed)."""
 
 
 @dataclass(frozen=True)
@@ -91,18 +66,6 @@ class MotorParams(_Validated):
     def k_t(self) -> float:
         """Torque constant, k_t = 1.5·k_e [N·m/A] (amplitude-invariant i_q)."""
         return 1.5 * self.k_e
-
-
-@dataclass(frozen=True)
-class InverterParams(_Validated):
-    """Two-level inverter driven by per-phase hysteresis comparators.
-
-    V_dc : float  DC bus voltage [V]
-    h : float  total width of the hysteresis band [A]
-    """
-
-    V_dc: float = _p(48.0, "V_dc", "V", "DC bus voltage")
-    h: float = _p(0.1, "h", "A", "hysteresis band, total width")
 
 
 @dataclass(frozen=True)
@@ -226,7 +189,7 @@ class EmaParams(_Validated):
     """All parameters of the EMA, grouped as the block diagram.
 
     motor : MotorParams  the PMSM
-    inverter : InverterParams  the two-level inverter and its hysteresis comparators
+    inverter : InverterParams  the two-level inverter and its current control (hysteresis or FOC)
     transmission : TransmissionParams  gearbox and user load
     controller : ControllerParams  the control electronics: sampled PID position loop, sample rate f_s
     sensors : SensorParams  ADC quantisation and measurement noise
@@ -252,13 +215,15 @@ class EmaParams(_Validated):
         """Integration steps per controller/sensor sample period."""
         return round(1.0 / (self.controller.f_s * self.integration.dt))
 
-    def to_dict(self) -> dict[str, dict[str, float]]:
-        """Plain nested dict of every value (for result metadata)."""
-        return dataclasses.asdict(self)
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        """Plain nested dict of every value in use (for result metadata and the params hash): each
+        group's `to_dict`, so the inverter holds only its control mode's keys."""
+        return {f.name: getattr(self, f.name).to_dict() for f in dataclasses.fields(self)}
 
     @classmethod
-    def from_dict(cls, data: dict[str, dict[str, float]]) -> EmaParams:
-        """Inverse of `to_dict`; unknown groups or fields raise `InputError`."""
+    def from_dict(cls, data: dict[str, dict[str, Any]]) -> EmaParams:
+        """Inverse of `to_dict` (missing fields take their defaults); unknown groups or fields
+        raise `InputError`."""
         groups: dict[str, Any] = {f.name: f.default_factory for f in dataclasses.fields(cls)}
         unknown = set(data) - set(groups)
         if unknown:
@@ -273,14 +238,15 @@ _GROUPS = (MotorParams, InverterParams, TransmissionParams, ControllerParams, Se
 
 
 def parameter_table_markdown() -> str:
-    """The nominal parameter table (Markdown), generated from the dataclass metadata."""
+    """The nominal parameter table (Markdown), generated from the dataclass metadata; the inverter
+    fields of one control mode only say so."""
+    only = {key: mode for mode, keys in MODE_KEYS.items() for key in keys}  # InverterParams' names
     lines = ["| group | symbol | meaning | value | unit |", "|---|---|---|---|---|"]
     for group in _GROUPS:
         instance = group()
         for f in dataclasses.fields(group):
             m = f.metadata
-            value = getattr(instance, f.name)
-            lines.append(
-                f"| {group.__name__} | `{f.name}` ({m['symbol']}) | {m['doc']} | {value:g} | {m['unit']} |"
-            )
+            value = format_value(getattr(instance, f.name))
+            doc = m["doc"] + (f" (control = {only[f.name]} only)" if f.name in only else "")
+            lines.append(f"| {group.__name__} | `{f.name}` ({m['symbol']}) | {doc} | {value} | {m['unit']} |")
     return "\n".join(lines) + "\n"

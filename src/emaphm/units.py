@@ -60,6 +60,8 @@ UNITS: dict[str, dict[str, float]] = {
     "A/rad": {"A/rad": 1.0, "A/deg": 1.0 / _DEG},
     "A/(rad·s)": {"A/(rad·s)": 1.0, "A/(deg·s)": 1.0 / _DEG},
     "A·s/rad": {"A·s/rad": 1.0, "A·s/deg": 1.0 / _DEG},
+    "V/A": {"V/A": 1.0, "Ω": 1.0, "mV/A": 1e-3},  # an FOC drive's PI gains (InverterParams)
+    "V/(A·s)": {"V/(A·s)": 1.0, "kV/(A·s)": 1e3},
     # "μs" is GREEK SMALL LETTER MU U+03BC, "µs" MICRO SIGN U+00B5
     "s": {"s": 1.0, "ms": 1e-3, "µs": 1e-6, "us": 1e-6, "μs": 1e-6, "ns": 1e-9},
     "Hz": {"Hz": 1.0, "kHz": 1e3},

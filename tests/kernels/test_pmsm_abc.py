@@ -246,6 +246,8 @@ def test_fast_loop_matches_stator_step_and_mechanics_step(case):
     from emaphm.kernels.controller import ControllerPack
     from emaphm.kernels.hf_twin import N_OUT, simulate_hf
     from emaphm.kernels.mechanics import MechanicsPack
+    from emaphm.models.hf import foc_pack
+    from emaphm.params import EmaParams
 
     N = case["N"]
     sp = stator_pack(V_dc, 0.1, 4, [n * R_s for n in N], [n**2 * L_s for n in N],
@@ -257,7 +259,7 @@ def test_fast_loop_matches_stator_step_and_mechanics_step(case):
     noise = np.random.default_rng(1).normal(0.0, 1e-5, len(t))
     args = (cmd, noise, 1.8e-5, 0.6, cp, sp, mp, 1e-6, 100, case["n_sub"])
     fast = np.empty((len(t), N_OUT))
-    simulate_hf(*args, fast)
+    simulate_hf(*args[:7], foc_pack(EmaParams()), *args[7:], fast)  # hysteresis: fp.on = 0
     ref = reference_hf(*args)
     scale = np.max(np.abs(ref), axis=0)
     assert np.all(np.abs(fast - ref) <= 1e-9 * scale + 1e-300)

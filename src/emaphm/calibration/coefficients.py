@@ -181,8 +181,23 @@ def _nameplate_ratios(params: EmaParams | None) -> dict[str, float]:
         "k_t_eq": params.motor.k_t / nominal.motor.k_t,
         "k_e_eq": params.motor.k_e / nominal.motor.k_e,
         "J_eq": params.transmission.J / nominal.transmission.J,
-        **{name: params.inverter.h / nominal.inverter.h for name in BAND_SCALED},
+        **{name: current_ripple(params) / nominal.inverter.h for name in BAND_SCALED},
     }
+
+
+def current_ripple(params: EmaParams) -> float:
+    """The scale of the drive's current ripple [A]: the band h of a hysteresis drive; for an FOC
+    drive V_dc/(8·L_s·f_pwm), the largest peak-to-peak ripple of a centre-aligned PWM leg into the
+    phase inductance (at duty ½)."""
+    inv = params.inverter
+    if getattr(inv, "foc", False):
+        return inv.V_dc / (8.0 * params.motor.L_s * inv.f_pwm)
+    return inv.h
+
+
+# the coefficients an FOC drive's monitor does not use: the hysteresis loop's lag (the drive's own PI
+# is simulated, kernels.monitor.foc_loop_step) and its dead zone at standstill (a PI loop has none)
+FOC_UNUSED = ("tau_i", "i_D")
 
 
 # the loop-error surrogate's coefficients, the loop's breakaway ripple and its dead zone, which

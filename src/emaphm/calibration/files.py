@@ -6,11 +6,10 @@ the packaged ones ship as ``emaphm/data/calibration.json`` (and ``calibration-pa
 paper's monitor) and are what the LF model loads by default.
 
 A calibration belongs to one actuator: it records the parameters it was fitted for
-(``settings.params``) and their digest (``params_hash``, `params_hash`). `MonitorEma` refuses
-a calibration made for other parameters (`Calibration.check_params`): the LF model would
-otherwise mix the user's drive train with, e.g., the inertia J_eq fitted for another one.
-The measurement-noise levels (``sensors.sigma_*``) are not part of the actuator: they are left
-out of the comparison and of the digest.
+(``settings.params``) and their digest (``params_hash``, `params_hash`). `MonitorEma` refuses one
+made for other parameters (`Calibration.check_params`; another drive is named first): the LF model
+would otherwise mix the user's drive train with, e.g., the J_eq fitted for another one. The
+noise levels (``sensors.sigma_*``) are not part of the actuator nor of the digest.
 """
 
 from __future__ import annotations
@@ -118,17 +117,18 @@ class Calibration:
         if made_for is None:
             return
         mine, theirs = actuator_params(params.to_dict()), actuator_params(made_for)
-        differ = [
+        drive, their_drive = params.inverter.control, theirs.get("inverter", {}).get("control", "hysteresis")
+        differ = ([f"a {their_drive} drive, this one's is {drive}"] if drive != their_drive else []) + [
             f"{group}.{key} = {value!r} (calibrated for {theirs.get(group, {}).get(key)!r})"
             for group, values in mine.items()
             for key, value in values.items()
-            if theirs.get(group, {}).get(key) != value
+            if theirs.get(group, {}).get(key) != value and not (drive != their_drive and group == "inverter")
         ]
         if differ:
-            more = f" and {len(differ) - 2} more" if len(differ) > 2 else ""
             raise InputError(
                 f"{where} was made for other actuator parameters (hash {params_hash(made_for)}, these are "
-                f"{params_hash(params)}): {'; '.join(differ[:2])}{more}; "
+                f"{params_hash(params)}): {'; '.join(differ[:2])}"
+                f"{f' and {len(differ) - 2} more' if len(differ) > 2 else ''}; "
                 "calibrate the monitor for them ('emaphm calibrate --params FILE --output cal.json', "
                 "or emaphm.calibrate(params=...)) and pass that calibration"
             )

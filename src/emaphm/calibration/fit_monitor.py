@@ -33,7 +33,7 @@ from ..identification.optimizers import BatchProblem, minimize_batch
 from ..identification.signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 from ..models._base import check_seed
 from ..params import EmaParams
-from .coefficients import SURROGATE, Coefficients, checked_free, coefficient_bounds
+from .coefficients import FOC_UNUSED, SURROGATE, Coefficients, checked_free, coefficient_bounds
 from .files import Calibration, check_monitor, held_coefficients
 from .scenarios import (
     CALIBRATION_COMMANDS,
@@ -189,7 +189,10 @@ def _task(
             )
     # the searched coefficients; the paper's monitor keeps the surrogate at zero (no loop error)
     bounds = coefficient_bounds(params)
-    allowed = [n for n in bounds if not (paper and (n in SURROGATE or n == "V_H"))]
+    foc = params.inverter.foc
+    allowed = [
+        n for n in bounds if not (paper and (n in SURROGATE or n == "V_H")) and not (foc and n in FOC_UNUSED)
+    ]
     fitted = checked_free(free, allowed, monitor)
     initial, held_from = held_coefficients(free, start, monitor, params, n_lf)
     return _Task(

@@ -87,6 +87,13 @@ def calibrate_uq(
     monitor: MonitorOption = None,
     workers: WorkersOption = 0,
     params: ParamsNeedCalibrationOption = None,
+    drive_tolerance: Annotated[
+        float,
+        typer.Option(
+            help="FOC drives: draw each case's PI gains within ±this (relative) and its carrier phase; "
+            "no effect on a hysteresis drive."
+        ),
+    ] = 0.1,
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from ..actuator import resolve_params
@@ -98,6 +105,8 @@ def calibrate_uq(
     check_seed(seed)
     if cases < 20:
         raise InputError(f"--cases must be >= 20 (coverage needs a sample), got {cases}")
+    if not 0.0 <= drive_tolerance < 1.0:
+        raise InputError(f"--drive-tolerance must be in [0, 1), got {drive_tolerance:g}")
     check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
     actuator = resolve_params(params)
     MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
@@ -106,9 +115,11 @@ def calibrate_uq(
         report = logged(update)
         factors = run_calibrate_uq(
             cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
-            params=actuator,
+            params=actuator, drive_tolerance=drive_tolerance,
         )  # fmt: skip
     factors.save(output)
+    for case in factors.record["skipped"]:
+        err.print(f"left out case {case['case']}: the monitor does not explain it (NRMSE {case['fit_nrmse']:.3g})")
     for name, fit in factors.record["training"].items():
         err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
     err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")

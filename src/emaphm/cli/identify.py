@@ -48,6 +48,13 @@ UqCalibrationOption = Annotated[
     Path | None,
     typer.Option(help="Interval calibration from 'emaphm calibrate-uq' (default: the packaged one)."),
 ]
+DetectionOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--detection",
+        help="Detection thresholds from 'emaphm calibrate-detection' for this actuator (default: the packaged ones).",
+    ),
+]
 ReportOption = Annotated[
     Path | None,
     typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
@@ -62,6 +69,7 @@ def identify(
     output: OutputOption = None,
     calibration: CalibrationOption = None,
     uq_calibration: UqCalibrationOption = None,
+    detection: DetectionOption = None,
     params: ParamsNeedCalibrationOption = None,
     report: ReportOption = None,
     **options: Any,
@@ -80,11 +88,17 @@ def identify(
     truth = _checked_inputs(
         true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
+        detection=detection,
     )  # fmt: skip
+    thresholds = None
+    if detection is not None:
+        from ..identification.detection import load_thresholds
+
+        thresholds = dict(load_thresholds(detection)["thresholds"])
     with progress() as update:
         result = run_identify(
             truth, reference, settings=settings, calibration=calibration, uq_calibration=uq_calibration,
-            params=params, channel_map=map_file,
+            params=params, channel_map=map_file, thresholds=thresholds,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{settings.optimizer.upper()} generations", abs(gen), total
             ),
@@ -119,7 +133,7 @@ with_settings_options(identify)
 def _checked_inputs(
     *, true_faults: str | None, reference: Path | None, map_file: Path | None, uncertainty: str,
     uq_calibration: Path | None, output: Path | None, report: Path | None, calibration: Path | None,
-    params: Path | None,
+    params: Path | None, detection: Path | None = None,
 ) -> Any:  # fmt: skip
     """Every check of `identify`'s inputs and files, before the work (the settings are checked
     when made, first): the truth or None. The input files, the output paths (none may be one of the
@@ -141,12 +155,16 @@ def _checked_inputs(
         ChannelMap.load(map_file)  # a bad map: refused before the work
     if output is not None:
         check_output_path(
-            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params, map_file)
+            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params, map_file, detection)
         )
     if report is not None:
         from ..report import check_report_dir
 
         check_report_dir(report)
+    if detection is not None:
+        from ..identification.detection import load_thresholds
+
+        load_thresholds(detection)  # a bad file: refused before the work
     if uncertainty == "none" and uq_calibration is not None:
         raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
     if uncertainty != "none":

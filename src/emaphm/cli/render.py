@@ -134,13 +134,15 @@ def print_inspection(info: dict[str, Any]) -> None:
 
 
 def print_params(actuator: Any, source: str) -> None:
-    """`emaphm params`: every parameter of `actuator` with its unit, the nominal value and its meaning."""
+    """`emaphm params`: every parameter of `actuator` in use with its unit, the nominal value and its
+    meaning (the inverter: control, V_dc and the keys of its control mode)."""
     import dataclasses
 
+    from rich.markup import escape
     from rich.table import Table
 
     from ..calibration import params_hash
-    from ..params import EmaParams
+    from ..params import EmaParams, format_value
 
     nominal = EmaParams()
     table = Table(title=f"{source} (hash {params_hash(actuator)})")
@@ -148,10 +150,19 @@ def print_params(actuator: Any, source: str) -> None:
         table.add_column(column, justify="right" if column in ("value", "nominal") else "left")
     for group in dataclasses.fields(actuator):
         mine, theirs = getattr(actuator, group.name), getattr(nominal, group.name)
-        for f in dataclasses.fields(mine):
-            value, base = getattr(mine, f.name), getattr(theirs, f.name)
-            shown = f"{value:g}" if value == base else f"[bold]{value:g}[/bold]"
-            table.add_row(group.name, f.name, shown, f.metadata["unit"], f"{base:g}", f.metadata["doc"])
+        meta = {f.name: f.metadata for f in dataclasses.fields(mine)}
+        for name in mine.fields_in_use():
+            value, base = getattr(mine, name), getattr(theirs, name)
+            shown = escape(format_value(value))
+            shown = shown if value == base else f"[bold]{shown}[/bold]"
+            table.add_row(
+                group.name,
+                name,
+                shown,
+                meta[name]["unit"],
+                escape(format_value(base)),
+                escape(meta[name]["doc"]),
+            )
     stdout_console().print(table)
 
 

@@ -52,6 +52,20 @@ def recording_warnings(
             "rests, whose current does not depend on the faults, or motion faster than the monitor was fitted on; "
             "the diagnosis rests on little data"
         )
+    if thresholds is None:
+        from ..calibration.files import params_hash
+        from ..params import EmaParams
+
+        # the packaged thresholds were measured on the nominal actuator (older files do not say so)
+        made_for = load_thresholds().get("params_hash") or params_hash(EmaParams())
+        this = params_hash(context.monitor.params)
+        if made_for is not None and made_for != this:
+            drive = context.monitor.params.inverter.control
+            warnings.append(
+                f"the detection thresholds were measured on another actuator (hash {made_for}; this one "
+                f"{this}, a {drive} drive): run 'emaphm calibrate-detection --params FILE' and pass its "
+                "file with --detection"
+            )
     measured_with = load_thresholds().get("monitor", "default") if thresholds is None else None
     if measured_with is not None and measured_with != context.monitor.monitor:
         warnings.append(

@@ -40,6 +40,7 @@ import math
 
 from ._jit import jit
 from .controller import pid_step
+from .foc import carried, drive_update, leg_state, window
 from .pmsm_abc import euler_map
 from .sensors import quantise
 from .transforms import HALF_SQRT3, SQRT3
@@ -102,13 +103,14 @@ def _comparators(i_a, i_b, i_c, s_a, s_b, s_c, lo_a, lo_b, lo_c, hi_a, hi_b, hi_
 
 
 @jit(nogil=True)  # a batch of runs on Python threads (`HighFidelityEma.simulate_batch`)
-def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_per_sample, n_sub, out):  # type: ignore[no-untyped-def]
+def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, fp, dt, n_per_sample, n_sub, out):  # type: ignore[no-untyped-def]
     """Run the HF twin over len(theta_cmd) samples, writing `out` (shape (n, N_OUT)).
 
     theta_cmd : command at the sample instants [rad]; theta_noise : position noise per sample [rad];
-    lsb_theta, fs_theta : position ADC step and full scale [rad]; cp, sp, mp : controller, stator
-    and mechanics packs; dt : step [s]; n_per_sample : steps per sample; n_sub : electrical
-    sub-steps per step (states s_x start at +1).
+    lsb_theta, fs_theta : position ADC step and full scale [rad]; cp, sp, mp, fp : controller,
+    stator, mechanics and drive packs (fp.on = 0: the hysteresis comparators, states s_x starting
+    at +1; else the FOC drive of `foc`, duties starting at ½); dt : step [s]; n_per_sample : steps
+    per sample; n_sub : electrical sub-steps per step.
     """
     n = theta_cmd.shape[0]
     # ---- run constants ------------------------------------------------------------------------
@@ -177,6 +179,22 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_p
     vs_b = V_ba * s_a + V_bb * s_b + V_bc * s_c
     integral = 0.0
     omega_f = 0.0
+    # FOC drive (foc.py): PI integrators, the duties in force and the two queued behind them, the
+    # current update interval (its start, whether it starts at a carrier peak, the legs' windows)
+    foc = fp.on != 0.0
+    delay = int(fp.delay)
+    I_d = 0.0
+    I_q = 0.0
+    d_a = d_b = d_c = q1_a = q1_b = q1_c = q2_a = q2_b = q2_c = 0.5
+    n_update = 0
+    next_update = fp.t_first
+    t_window = fp.t_first - fp.T_u
+    peak = fp.first_peak == 0.0 if fp.double != 0.0 else True
+    wl_a, wh_a = window(0.5, peak, fp)
+    wl_b, wh_b = wl_a, wh_a
+    wl_c, wh_c = wl_a, wh_a
+    ce_a = ce_b = ce_c = ck_a = ck_b = ck_c = 0.0  # dead time carried into the interval (foc.carried)
+    n_step = 0
     acc_a = 0.0
     acc_b = 0.0
     acc_q = 0.0
@@ -231,7 +249,58 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, dt, n_p
             hi_a = i_q_ref * u_a + half_h
             hi_b = i_q_ref * u_b + half_h
             hi_c = i_q_ref * u_c + half_h
-            if n_sub == 1:
+            if foc:
+                t_now = n_step * dt
+                if t_now >= next_update - 1e-3 * dt:  # sample, PI, duties (foc.drive_update)
+                    n_a, n_b, n_c, I_d, I_q = drive_update(
+                        i_a, i_b, sin_e, cos_e, omega_m, i_q_ref, I_d, I_q, fp
+                    )
+                    if delay == 0:
+                        d_a, d_b, d_c = n_a, n_b, n_c
+                    elif delay == 1:
+                        d_a, d_b, d_c = q1_a, q1_b, q1_c
+                        q1_a, q1_b, q1_c = n_a, n_b, n_c
+                    else:
+                        d_a, d_b, d_c = q2_a, q2_b, q2_c
+                        q2_a, q2_b, q2_c = q1_a, q1_b, q1_c
+                        q1_a, q1_b, q1_c = n_a, n_b, n_c
+                    t_window = next_update
+                    n_update += 1
+                    next_update = fp.t_first + n_update * fp.T_u
+                    if fp.double != 0.0:
+                        peak = not peak
+                    nl_a, nh_a = window(d_a, peak, fp)
+                    nl_b, nh_b = window(d_b, peak, fp)
+                    nl_c, nh_c = window(d_c, peak, fp)
+                    ce_a, ck_a = carried(wl_a, wh_a, nl_a, nh_a, fp)
+                    ce_b, ck_b = carried(wl_b, wh_b, nl_b, nh_b, fp)
+                    ce_c, ck_c = carried(wl_c, wh_c, nl_c, nh_c, fp)
+                    wl_a, wh_a, wl_b, wh_b, wl_c, wh_c = nl_a, nh_a, nl_b, nh_b, nl_c, nh_c
+                tau_w = t_now - t_window
+                s_a = leg_state(tau_w, dt, wl_a, wh_a, ce_a, ck_a, i_a, fp)
+                s_b = leg_state(tau_w, dt, wl_b, wh_b, ce_b, ck_b, i_b, fp)
+                s_c = leg_state(tau_w, dt, wl_c, wh_c, ce_c, ck_c, -(i_a + i_b), fp)
+                vs_a = V_aa * s_a + V_ab * s_b + V_ac * s_c
+                vs_b = V_ba * s_a + V_bb * s_b + V_bc * s_c
+                n_step += 1
+                if n_sub == 1:
+                    i_a, i_b = (
+                        (A_aa * i_a + A_ab * i_b + vs_a) + be_a,
+                        (A_ba * i_a + A_bb * i_b + vs_b) + be_b,
+                    )
+                    T_m = g_ac * i_a + g_bc * i_b
+                else:
+                    T_sum = 0.0
+                    bv_a = vs_a + be_a  # the step's volt-seconds spread evenly over its sub-steps
+                    bv_b = vs_b + be_b
+                    for _ in range(n_sub):
+                        i_a, i_b = (
+                            (A_aa * i_a + A_ab * i_b) + bv_a,
+                            (A_ba * i_a + A_bb * i_b) + bv_b,
+                        )
+                        T_sum += g_ac * i_a + g_bc * i_b
+                    T_m = T_sum * inv_sub
+            elif n_sub == 1:
                 s_a, s_b, s_c, switched = _comparators(
                     i_a, i_b, -(i_a + i_b), s_a, s_b, s_c, lo_a, lo_b, lo_c, hi_a, hi_b, hi_c
                 )

@@ -53,6 +53,10 @@ LF_FIELDS = (
     "i_R", "i_D",
     # LF steps per sample period
     "n_lf",
+    # the drive's current loop: 0 the hysteresis loop (the lag τ_i above), 1 an FOC drive's q-axis PI
+    # (`foc_loop_step`): its gains, updates per LF step, computation delay [updates], back-EMF
+    # feed-forward constant (0: none) and voltage limit
+    "foc", "K_p_i", "K_i_i", "n_u", "delay", "k_e_ff", "V_lim",
 )  # fmt: skip
 IDX = {name: j for j, name in enumerate(LF_FIELDS)}
 N_FIELDS = len(LF_FIELDS)
@@ -62,7 +66,8 @@ N_AUX = len(AUX_COLUMNS)
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
  LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX, ECC_COUPLING,
- K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, I_D, N_LF) = range(N_FIELDS)  # fmt: skip
+ K_H, DELTA_0, DELTA_1, DELTA_U, DELTA_2, V_H, I_R, I_D, N_LF,
+ FOC, K_P_I, K_I_I, N_U, DELAY, K_E_FF, V_LIM) = range(N_FIELDS)  # fmt: skip
 
 
 @jit
@@ -170,6 +175,50 @@ def current_loop_step(i, i_ref, omega_m, phi_R, phi_E, decay, g, R_eq, k_e_eq, U
     return i + di
 
 
+@jit
+def foc_loop_step(i, I_q, v_1, v_2, i_ref, omega_m, phi_R, phi_E, h_u, prm):  # type: ignore[no-untyped-def]
+    """The q axis of an FOC drive over one LF step, in n_u PI updates of h_u each (kernels/foc.py):
+
+        v = K_p·(i_ref − i) + I_q + k_e,ff·ω_m,   limited to ±V_lim (I_q held while limited),
+        I_q += K_i·h_u·(i_ref − i),
+        L_eq·di/dt = u − R_eq·φ_R·i − k_e,eq·φ_E·ω_m,   u: the v computed `delay` updates earlier.
+
+    The PI sees the equivalent current, the plant is the monitor's equivalent circuit with its
+    shape functions, so the part of the back-EMF the nameplate feed-forward does not cancel (the
+    lost turns' 2θ_e ripple, the eccentricity) drives a current error through the loop's finite
+    stiffness, as the twin's PI lets it through. Returns (i, I_q, v_1, v_2, mean of i over the step).
+    """
+    g = h_u / prm[L_EQ]
+    drop_e = prm[K_E_EQ] * phi_E * omega_m
+    r = prm[R_EQ] * phi_R
+    ff = prm[K_E_FF] * omega_m
+    delay = prm[DELAY]
+    n_u = int(prm[N_U])
+    acc = 0.0
+    for _ in range(n_u):
+        e = i_ref - i
+        v = prm[K_P_I] * e + I_q + ff
+        if v > prm[V_LIM]:
+            v = prm[V_LIM]
+        elif v < -prm[V_LIM]:
+            v = -prm[V_LIM]
+        else:
+            I_q += prm[K_I_I] * h_u * e
+        if delay == 0.0:
+            u = v
+        elif delay == 1.0:
+            u = v_1
+            v_1 = v
+        else:
+            u = v_2
+            v_2 = v_1
+            v_1 = v
+        i_new = i + g * (u - r * i - drop_e)
+        acc += 0.5 * (i + i_new)  # the mean over the update period (trapezoid)
+        i = i_new
+    return i, I_q, v_1, v_2, acc / n_u
+
+
 # Where exactly one zero vector holds (`standstill_dead_zone`), whether the twin's loop is at rest
 # depends on its legs' switching state, which the monitor does not carry: on a locked rotor under the
 # twin's own comparators it was at rest in 0.514 ± 0.018 of 800 trials coming from a running loop and
@@ -252,6 +301,11 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     kz_sin = prm[K_E] * prm[ZETA] * math.sin(prm[PHI_E])
     per_phase = prm[ECC_COUPLING] != 0.0
     e2 = ecc_harmonics(prm[K_E] * prm[ZETA], prm[PHI_E])
+    foc = prm[FOC] != 0.0
+    h_u = dt / prm[N_U] if foc else 0.0
+    I_q = 0.0  # the FOC loop's integrator and its queued voltages
+    v_1 = 0.0
+    v_2 = 0.0
     theta_m = 0.0
     omega_m = 0.0
     theta_u = 0.0
@@ -288,7 +342,11 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
                 f_t = f_sc * f_ecc
                 k_t = prm[K_T_EQ] * f_sc * f_ecc
             carry = standstill_dead_zone(i_q_ref, omega_m, sin_e, cos_e, prm[I_D])
-            if carry == 0.0:
+            if foc:
+                i, I_q, v_1, v_2, i_loop = foc_loop_step(
+                    i, I_q, v_1, v_2, carry * i_q_ref, omega_m, f_sc, f_t, h_u, prm
+                )
+            elif carry == 0.0:
                 i *= decay_rl  # a zero vector: the current decays through R_eq, L_eq
             else:
                 i = current_loop_step(
@@ -303,10 +361,12 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
                     prm[K_E_EQ],
                     prm[U_MAX],
                 )
+            if not foc:  # the loop's current over the step: its end value (hysteresis), its mean (FOC)
+                i_loop = i
             # the current the motor carries and the sensors measure: the loop's surrogate error on top
             c2 = unbalance_2(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C])
             i_m = loop_error(
-                i, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
+                i_loop, omega_m, c2, offset_0, prm[K_H], prm[DELTA_2], prm[R_EQ], prm[K_E_EQ], prm[V_H],
             )  # fmt: skip
             T_m = k_t * i_m
             # the hysteresis loop's ripple about i_m, which this step averages away, breaks a stuck

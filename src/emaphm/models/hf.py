@@ -11,17 +11,46 @@ from numpy.typing import ArrayLike
 from .._threads import thread_map
 from ..errors import InputError
 from ..faults import HEALTHY, FaultedParameters, apply_faults, as_fault_matrix, as_fault_vector
+from ..kernels.foc import FocPack
 from ..kernels.hf_twin import N_OUT, OUT_COLUMNS, simulate_hf
 from ..kernels.pmsm_abc import StatorPack, stator_pack
 from ..kernels.sensors import adc
 from ..kernels.transforms import clarke, park
+from ..params import EmaParams
 from ..results import SimResult
 from ._base import _EmaModel, check_finite, check_seed, controller_pack, mechanics_pack
 
-__all__ = ["MAX_SUBSTEPS", "HighFidelityEma"]
+__all__ = ["MAX_SUBSTEPS", "HighFidelityEma", "foc_pack"]
 
 # 6x the sub-steps of the most shorted coil the fault vector allows (N = 0.05, n_sub ~ 320)
 MAX_SUBSTEPS = 2000
+# FOC: largest step over the fastest electrical time constant of a pair of phases in series
+FOC_STEP_FRACTION = 0.02
+
+
+def foc_pack(params: EmaParams) -> FocPack:
+    """The FOC drive's run constants (`kernels.foc`) for `params`; on = 0 for a hysteresis drive."""
+    inv, m = params.inverter, params.motor
+    if not getattr(inv, "foc", False):
+        return FocPack(
+            0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0
+        )
+    double = inv.update == "double"
+    # update instants: the peaks at (j − φ)·T_pwm, with the valleys half a period later when double
+    T_u = inv.T_update
+    j = math.ceil(inv.pwm_phase * inv.T_pwm / T_u - 1e-9)  # the first instant j·T_u − φ·T_pwm ≥ 0
+    t_first = j * T_u - inv.pwm_phase * inv.T_pwm
+    first_peak = True
+    if double:
+        first_peak = round((t_first + inv.pwm_phase * inv.T_pwm) / T_u) % 2 == 0
+    advance = (inv.computation_delay + 0.5) if inv.angle_compensation else 0.0
+    return FocPack(
+        1.0, inv.T_pwm, T_u, float(double), max(t_first, 0.0), float(first_peak),
+        float(inv.computation_delay), inv.dead_time, float(inv.dead_time_compensation),
+        inv.K_p_i, inv.K_i_i, float(inv.modulation == "svpwm"), float(inv.decoupling),
+        float(inv.emf_feedforward), advance, inv.voltage_limit * inv.V_linear, inv.V_dc,
+        m.L_s, m.psi_m, float(m.p),
+    )  # fmt: skip
 
 
 class HighFidelityEma(_EmaModel):
@@ -56,6 +85,12 @@ class HighFidelityEma(_EmaModel):
         by orders of magnitude): `InputError`, instead of a silent hang.
         """
         integ = self.params.integration
+        if getattr(self.params.inverter, "foc", False):
+            # PWM: the volt-seconds of each step are exact (kernels.foc), so the sub-step only has
+            # to resolve the stator's own dynamics: the fastest pair of phases in series
+            pairs = ((sp.L_a + sp.L_b) / (sp.R_a + sp.R_b), (sp.L_b + sp.L_c) / (sp.R_b + sp.R_c),
+                     (sp.L_c + sp.L_a) / (sp.R_c + sp.R_a))  # fmt: skip
+            return max(1, math.ceil(integ.dt / (FOC_STEP_FRACTION * min(pairs)) - 1e-9))
         L_min = min(sp.L_a, sp.L_b, sp.L_c)
         n_sub = max(1, math.ceil(sp.V_dc * integ.dt / (L_min * integ.ripple_fraction * sp.h) - 1e-9))
         if n_sub > MAX_SUBSTEPS:
@@ -129,7 +164,7 @@ class HighFidelityEma(_EmaModel):
         out = np.empty((n, N_OUT))
         simulate_hf(
             theta_cmd, theta_noise, sens.lsb_position, sens.full_scale_position,
-            controller_pack(params, fp), sp, mechanics_pack(params, fp),
+            controller_pack(params, fp), sp, mechanics_pack(params, fp), foc_pack(params),
             params.integration.dt, params.steps_per_sample, n_sub, out,
         )  # fmt: skip
         check_finite(out, self.model, k)

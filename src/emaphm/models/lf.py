@@ -41,6 +41,29 @@ def resolve_calibration(
     return cal
 
 
+def drive_fields(params: EmaParams, n_lf: int) -> dict[str, float]:
+    """The monitor's current-loop fields (`kernels.monitor.LF_FIELDS`) for the actuator's drive.
+
+    Hysteresis: foc = 0 (the lag τ_i). FOC: the drive's PI gains, its updates per LF step (the
+    nearest whole number, at least 1: the LF step is split into that many PI periods), its
+    computation delay, the nameplate back-EMF constant it feeds forward (0 when off) and its
+    voltage limit.
+    """
+    inv = params.inverter
+    if not getattr(inv, "foc", False):
+        return {"foc": 0.0, "K_p_i": 0.0, "K_i_i": 0.0, "n_u": 1.0, "delay": 0.0, "k_e_ff": 0.0, "V_lim": 0.0}
+    dt_lf = 1.0 / (params.controller.f_s * n_lf)
+    return {
+        "foc": 1.0,
+        "K_p_i": inv.K_p_i,
+        "K_i_i": inv.K_i_i,
+        "n_u": float(max(1, round(dt_lf / inv.T_update))),
+        "delay": float(inv.computation_delay),
+        "k_e_ff": params.motor.k_e if inv.emf_feedforward else 0.0,
+        "V_lim": inv.voltage_limit * inv.V_linear,
+    }
+
+
 def monitor_rows(
     K: NDArray[np.float64],
     params: EmaParams,
@@ -70,6 +93,7 @@ def monitor_rows(
         "R_eq": mot.R_s, "L_eq": mot.L_s, "U_max": params.inverter.V_dc / math.sqrt(3.0), "n_lf": n_lf,
         "ecc_coupling": 1.0 if check_monitor(monitor) == "default" else 0.0,
     }  # fmt: skip
+    fixed.update(drive_fields(params, n_lf))
     for name, value in fixed.items():
         rows[:, IDX[name]] = value
     cal: dict[str, list[float]] = {
