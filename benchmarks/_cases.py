@@ -29,6 +29,7 @@ from emaphm.campaign.store import RESULT_COLUMNS
 from emaphm.choices import LAST_STAGES
 from emaphm.commands import SampledCommand
 from emaphm.faults import random_faults
+from emaphm.identification.detection import load_thresholds
 from emaphm.identification.fitness import Fitness
 from emaphm.identification.last_stage import SwitchingModel
 from emaphm.identification.limits import SECOND_SEARCH_NRMSE
@@ -56,6 +57,7 @@ __all__ = [
     "laplace",
     "load_factors",
     "load_params",
+    "load_thresholds",
     "machine_line",
     "measure",
     "noise_seed_of",

@@ -1,6 +1,7 @@
 """Identification on a field-oriented-control drive off its twin (issue 32): accuracy, intervals, verdicts.
 
     python benchmarks/bench_foc.py --params FOC.toml --calibration CAL.json [--uq-calibration UQ.json]
+                                   [--detection DETECTION.json]
                                    [--cases 12] [--seeds 2] [--case-seed 3203] [--healthy 3]
                                    [--drive-tolerance 0.1] [--tolerance 0.0] [--steps 5e-7,1e-6,2e-6]
                                    [--last-stage auto|switching|none]
@@ -37,6 +38,7 @@ from _cases import (  # benchmarks/ is the script's folder, first on sys.path
     covers,
     draw_cases,
     drawn_actuator,
+    load_thresholds,
     machine_line,
     noise_seed_of,
     params_hash,
@@ -59,6 +61,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--params", default=None, help="FOC actuator file (default: the nominal actuator)")
     parser.add_argument("--calibration", default=None, help="its monitor calibration (default: packaged)")
     parser.add_argument("--uq-calibration", default=None, help="its interval calibration (default: packaged)")
+    parser.add_argument("--detection", default=None, help="its detection thresholds (default: packaged)")
     parser.add_argument("--cases", type=int, default=12)
     parser.add_argument("--seeds", type=int, default=2)
     parser.add_argument("--case-seed", type=int, default=3203)
@@ -74,9 +77,12 @@ def main(argv: list[str] | None = None) -> None:
     print(machine_line(
         f"{args.cases} cases (seed {args.case_seed}) x {args.seeds} seeds + {args.healthy} healthy; actuator "
         f"{args.params or 'nominal'} ({params_hash(params)}, control {params.inverter.control}), calibration "
-        f"{args.calibration or 'packaged'}, intervals {args.uq_calibration or 'packaged'}; plants: PI ±"
+        f"{args.calibration or 'packaged'}, intervals {args.uq_calibration or 'packaged'}, detection "
+        f"{args.detection or 'packaged'}; plants: PI ±"
         f"{args.drive_tolerance:g}, constants ±{args.tolerance:g}, steps {args.steps}; {budget_text(args)}, "
         f"last stage {args.last_stage}"))  # fmt: skip
+
+    thresholds = None if args.detection is None else dict(load_thresholds(args.detection)["thresholds"])
 
     def run(k: np.ndarray, case: int, seed: int) -> emaphm.IdentificationResult:
         plant = drawn_actuator(params, 7919 * case + seed, tolerance=args.tolerance,
@@ -84,7 +90,7 @@ def main(argv: list[str] | None = None) -> None:
         trace = emaphm.HighFidelityEma(plant).simulate(k, seed=noise_seed_of(seed))
         return emaphm.identify(
             reference=trace, seed=seed, params=params, calibration=args.calibration,
-            uq_calibration=args.uq_calibration, **settings_of(args, SETTINGS),
+            uq_calibration=args.uq_calibration, thresholds=thresholds, **settings_of(args, SETTINGS),
         )  # fmt: skip
 
     errs, fits, inside, fits_bad, unwarned_bad = [], [], [], 0, 0

@@ -475,3 +475,48 @@ def test_an_8_khz_actuator_identifies_from_the_shell_with_the_switching_last_sta
     assert code in (0, 3) and data["settings"]["last_stage"] == "switching"
     for step in switching["steps_s"]:  # whole fractions of the 125 us sample period
         assert 125e-6 / step == pytest.approx(round(125e-6 / step), abs=1e-9)
+
+
+@pytest.mark.slow  # a tiny calibration and identification of an FOC actuator, ~5 s
+def test_an_foc_actuator_calibrates_and_identifies_from_the_shell(tmp_path, capsys, monkeypatch):
+    # issue 32: `emaphm calibrate --params foc.toml` works as for a hysteresis actuator, the
+    # identification says which packaged file belongs to another actuator, and --detection takes
+    # the actuator's own thresholds (a bad file refused in one line, before the work)
+    import json
+
+    from emaphm.identification import limits
+    from emaphm.identification.detection import DETECTABLE
+
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
+    actuator = tmp_path / "foc.toml"
+    actuator.write_text('[inverter]\ncontrol = "foc"\nf_pwm = "20 kHz"\nK_p_i = "9.42 V/A"\n')
+    cal = tmp_path / "cal.json"
+    code, _, _ = run_cli(["calibrate", "--params", str(actuator), "--pop-size", "4", "--generations", "1",
+                          "--output", str(cal)], capsys)  # fmt: skip
+    assert code == 0
+    record = json.loads(cal.read_text())
+    assert "tau_i" not in record["settings"]["fitted"] and "i_D" not in record["settings"]["fitted"]
+    assert record["settings"]["params"]["inverter"]["control"] == "foc"
+    args = ["identify", "--params", str(actuator), "--calibration", str(cal), "--true-faults",
+            "0.2,0,0,0.3,0,0,0,0.5", "--pop-size", "8", "--generations", "2", "--json"]  # fmt: skip
+    code, out, err = run_cli(args, capsys)
+    data = json.loads(out)
+    assert code in (0, 3)
+    warned = " ".join(data["warnings"])
+    assert "detection thresholds were measured on another actuator" in warned and "foc drive" in warned
+    assert "interval calibration was fitted with another LF calibration" in warned
+    thresholds = tmp_path / "det.json"
+    thresholds.write_text(json.dumps({"thresholds": dict.fromkeys(DETECTABLE, 10.0)}))
+    code, out, _ = run_cli([*args, "--detection", str(thresholds)], capsys)
+    data = json.loads(out)
+    assert "detection thresholds were measured" not in " ".join(data["warnings"])
+    assert data["detected"] == []  # every fault below a threshold of 10
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"thresholds": {"friction": -1}}')
+    code, out, err = run_cli([*args, "--detection", str(bad)], capsys)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "detection thresholds" in err
+    # a calibration of the hysteresis drive is refused for it, naming the drives
+    code, _, err = run_cli(["identify", "--params", str(actuator), "--calibration",
+                            str(Path(emaphm.__file__).parent / "data" / "calibration.json"),
+                            "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)  # fmt: skip
+    assert code == 2 and "a hysteresis drive, this one's is foc" in " ".join(err.split())

@@ -10,3 +10,52 @@ from emaphm.calibration import UQ_CASE_SEED, calibrate_uq
 def test_calibrate_uq_refuses_too_few_cases_before_the_work(cases):
     with pytest.raises(InputError, match="cases must be a whole number >= 20"):
         calibrate_uq(cases=cases, seed=UQ_CASE_SEED)
+
+
+class _Result:
+    def __init__(self, k, fits):
+        import numpy as np
+
+        self.estimate = np.asarray(k, dtype=float)
+        self.fit_nrmse = 0.01 if fits else 0.4
+        self.wall_time_s = 0.0
+        self.uncertainty = type("U", (), {"raw_std": np.full(8, 0.01)})() if fits else None
+
+
+@pytest.fixture
+def fake_identify(monkeypatch):
+    """identify() replaced by a recorder: which source each case got; case 2 does not fit."""
+    from emaphm.identification import api
+
+    calls = []
+
+    def identify(true_faults=None, reference=None, **options):
+        calls.append({"true_faults": true_faults, "reference": reference, **options})
+        k = true_faults if true_faults is not None else [0.0] * 8
+        return _Result(k, fits=len(calls) != 3)
+
+    monkeypatch.setattr(api, "identify", identify)
+    return calls
+
+
+def test_an_foc_drive_is_calibrated_on_drawn_drives_and_a_case_that_does_not_fit_is_left_out(fake_identify):
+    from emaphm.calibration.fit_intervals import collect_cases
+    from emaphm.params import EmaParams, InverterParams
+
+    foc = EmaParams(inverter=InverterParams(control="foc"))
+    data = collect_cases(12, 11, params=foc, drive_tolerance=0.1)
+    # each case measured on its own drawn drive's twin, passed as a recording
+    assert all(c["true_faults"] is None and c["reference"] is not None for c in fake_identify)
+    currents = [c["reference"].i_q for c in fake_identify]
+    assert not any((currents[0] == c).all() for c in currents[1:])
+    assert [s["case"] for s in data["skipped"]] == [2] and data["truths"].shape == (11, 8)
+
+
+def test_a_hysteresis_drive_is_calibrated_on_its_own_twin_and_too_many_misfits_refuse(fake_identify):
+    from emaphm.calibration.fit_intervals import collect_cases
+
+    data = collect_cases(12, 11, drive_tolerance=0.1)  # no PI to draw: the twin itself
+    assert all(c["reference"] is None for c in fake_identify) and len(data["skipped"]) == 1
+    fake_identify.clear()
+    with pytest.raises(InputError, match="1 of 4 cases did not fit"):
+        collect_cases(4, 11)  # 1 of 4 is more than the 10 % allowed

@@ -98,3 +98,18 @@ def test_the_foc_monitor_explains_an_foc_twin_better_than_the_hysteresis_monitor
     with_foc, with_hysteresis = nrmse(foc), nrmse(hysteresis)
     assert with_foc < 0.05
     assert with_hysteresis > 1.5 * with_foc
+
+
+def test_the_monitor_rows_carry_the_actuator_files_drive():
+    from emaphm.models.lf import drive_fields
+    from emaphm.params import EmaParams, InverterParams
+
+    assert drive_fields(EmaParams(), 1)["foc"] == 0.0  # hysteresis: the lag τ_i
+    inv = InverterParams(control="foc", f_pwm=16e3, update="double", computation_delay=2,
+                         emf_feedforward=False, modulation="sine", voltage_limit=0.9, K_p_i=5.0)  # fmt: skip
+    f = drive_fields(EmaParams(inverter=inv), 1)
+    # 100 µs LF step over a 31.25 µs update period: 3 PI updates per step (the nearest whole number)
+    assert f == {"foc": 1.0, "K_p_i": 5.0, "K_i_i": inv.K_i_i, "n_u": 3.0, "delay": 2.0, "k_e_ff": 0.0,
+                 "V_lim": pytest.approx(0.9 * 48.0 / 2)}  # fmt: skip
+    assert drive_fields(EmaParams(inverter=InverterParams(control="foc")), 2)["n_u"] == 1.0  # 50 µs steps
+    assert drive_fields(EmaParams(inverter=InverterParams(control="foc")), 1)["k_e_ff"] == pytest.approx(0.1)

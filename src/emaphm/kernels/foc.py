@@ -25,7 +25,8 @@ valley); a leg is high while the carrier is below its duty: over one period from
 [0, d·T/2] (`window`). During the dead time t_d after each edge both switches are off and the
 free-wheeling diode sets the leg by the phase current's sign: the rising edge comes t_d late
 when the current flows out of the leg (i_x > 0), the falling edge t_d late when it flows in
-(`leg_state`).
+(`leg_state`). An edge at an update instant, or one whose dead time runs past it (a duty near 1,
+or with a double update near 0), carries its dead time into the next interval (`carried`).
 
 The twin's fixed step Δt (1 µs) is finer than the carrier but coarser than an edge's timing: a
 leg enters a step as its high-time fraction over that step, s_x = 2·f_x − 1 ∈ [−1, 1], so the
