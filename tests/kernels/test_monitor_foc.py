@@ -113,3 +113,26 @@ def test_the_monitor_rows_carry_the_actuator_files_drive():
                  "V_lim": pytest.approx(0.9 * 48.0 / 2)}  # fmt: skip
     assert drive_fields(EmaParams(inverter=InverterParams(control="foc")), 2)["n_u"] == 1.0  # 50 µs steps
     assert drive_fields(EmaParams(inverter=InverterParams(control="foc")), 1)["k_e_ff"] == pytest.approx(0.1)
+
+
+def test_the_last_stages_switching_model_is_the_actuators_foc_drive_at_other_steps():
+    # issue 32, item 4: for an FOC actuator the last stage's switching model runs the FOC drive
+    import dataclasses
+
+    from emaphm.commands import Chirp
+    from emaphm.identification.last_stage import SwitchingModel
+    from emaphm.models.hf import HighFidelityEma
+    from emaphm.params import EmaParams, InverterParams
+
+    foc = EmaParams(inverter=InverterParams(control="foc", K_p_i=7.0))
+    model = SwitchingModel(foc, Chirp())
+    assert all(m.params.inverter == foc.inverter for m in model.models)
+    assert sorted(m.params.integration.dt for m in model.models) == pytest.approx([1.25e-6, 2e-6, 2.5e-6])
+    k = np.array([0.1, 0.1, 0.0, 0.2, 0.0, 0.1, 0.3, 0.5])
+    current = model.current(k, duration=0.05)
+    twin = HighFidelityEma(dataclasses.replace(foc, integration=dataclasses.replace(foc.integration, dt=2e-6)))
+    hysteresis = HighFidelityEma(dataclasses.replace(EmaParams(), integration=foc.integration))
+    i_foc = twin.simulate(k, noise=False, duration=0.05).i_q
+    i_hys = hysteresis.simulate(k, noise=False, duration=0.05).i_q
+    # the mean over its steps is near its FOC drive's current, farther from a hysteresis drive's
+    assert np.linalg.norm(current - i_foc) < 0.5 * np.linalg.norm(current - i_hys)
