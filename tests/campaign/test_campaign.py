@@ -241,6 +241,12 @@ def test_a_failing_job_is_recorded_and_the_campaign_goes_on(tmp_path, capsys):
     assert code == 1 and "2 job(s) failed" in err
     failures = ResultStore(tmp_path / "s").read("failures").to_pylist()
     assert {f["actuator"] for f in failures} == {"BAD"} and "is the current in mA" in failures[0]["message"]
+    # each failed job in one line (review: no traceback over the progress), the traceback in the store
+    lines = [line for line in err.splitlines() if line.startswith("emaphm: failed: actuator BAD flight")]
+    assert len(lines) == 2 and all("InputError" in line for line in lines)
+    assert "Traceback (most recent call last)" not in err
+    assert all(f["traceback"].startswith("Traceback (most recent call last)") for f in failures)
+    assert all("InputError" in f["traceback"].splitlines()[-1] for f in failures)
     code, out, _ = run_cli(["campaign", "status", str(spec), str(tmp_path / "s"), "--json"], capsys)
     data = json.loads(out)
     assert code == 0 and (data["done"], data["failed"], data["missing"]) == (12, 2, 0)
@@ -468,3 +474,21 @@ def test_a_cluster_whose_workers_run_several_threads_is_refused(tmp_path):
         with pytest.raises(InputError, match=r"run 2 threads each.*--nthreads 1"):
             run_campaign(write_spec(tmp_path), tmp_path / "store", scheduler=cluster.scheduler_address)
     assert not (tmp_path / "store" / "results").exists()
+
+
+@pytest.mark.slow  # ~4 s: a local dask cluster started and stopped
+def test_a_job_failing_on_a_dask_worker_prints_no_traceback(tmp_path, capfd):
+    # issue 35: the worker's own log of a failed task printed the whole traceback over the
+    # user's progress; the store keeps it, the worker is silent
+    pytest.importorskip("distributed")
+    trace = emaphm.simulate(seed=1, duration=0.3)
+    signals = dict(trace.signals)
+    emaphm.write_trace(emaphm.SimResult(t=trace.t, signals={**signals, "i_q": 1000 * signals["i_q"]}),
+                       tmp_path / "mA.h5")  # fmt: skip
+    spec = write_spec(tmp_path, extra='\n[[actuator]]\nid = "BAD"\nreference = "mA.h5"\n')
+    summary = run_campaign(spec, tmp_path / "s", workers=2)
+    err = capfd.readouterr().err
+    assert summary.failed == 2 and len(summary.failures) == 2
+    assert "Compute Failed" not in err and "Traceback" not in err
+    failures = ResultStore(tmp_path / "s").read("failures").to_pylist()
+    assert all("InputError" in f["traceback"] for f in failures)

@@ -6,7 +6,8 @@ that survives interruption.
 - `actuators`: its ``[[actuator]]`` and ``[[fleet]]`` tables, histories grown flight by flight;
 - `jobs`: one job, run anywhere from plain data (`run_job`);
 - `store`: the Parquet results store, written atomically;
-- `runner`: `run_campaign` (the missing and stale jobs only; Dask or serial); `status`: `campaign_status`.
+- `runner`: `run_campaign` (the missing and stale jobs only; serial, or on Dask by `cluster`); `status`:
+  `campaign_status`.
 
 ``emaphm campaign run SPEC.toml --out DIR`` and ``emaphm campaign status SPEC.toml DIR`` are the
 command line; docs/campaigns.md the guide.

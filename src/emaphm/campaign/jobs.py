@@ -11,6 +11,7 @@ import datetime as _dt
 import json
 import os
 import socket
+import traceback
 from typing import Any
 
 from .._version import __version__
@@ -90,8 +91,15 @@ def failure_row(
     """The failures row of a job that raised `error` (or whose worker died: a name and a message)."""
     name = error if isinstance(error, str) else type(error).__name__
     text = message if message is not None else " ".join(str(error).split())[:2000]
+    trace = None if isinstance(error, str) else "".join(traceback.format_exception(error))[-20000:]
     return {
         "job_key": job["key"], "campaign": job["campaign"], "actuator": job["actuator"], "flight": job["flight"],
-        "seed": job["seed"], "error": name, "message": text, "worker": _worker(), "finished": _now(),
-        "version": __version__,
+        "seed": job["seed"], "error": name, "message": text, "traceback": trace, "worker": _worker(),
+        "finished": _now(), "version": __version__,
     }  # fmt: skip
+
+
+def failure_line(row: dict[str, Any]) -> str:
+    """One line for a failures row: which job, and its error (the traceback stays in the store)."""
+    message = row["message"] if len(row["message"]) <= 200 else row["message"][:199] + "…"
+    return f"actuator {row['actuator']} flight {row['flight']} seed {row['seed']}: {row['error']}: {message}"

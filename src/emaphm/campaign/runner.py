@@ -27,7 +27,8 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from ..errors import InputError
-from .jobs import failure_row, run_job
+from .cluster import run_dask
+from .jobs import failure_line, failure_row, run_job
 from .spec import CampaignSpec, load_campaign
 from .store import ResultStore
 
@@ -40,9 +41,9 @@ Progress = Callable[[int, int, int, float], None]  # done, failed, to do, elapse
 class CampaignSummary:
     """What a run did: `campaign` (its name), `jobs` (in the spec), `already_done` (in the store
     before, made by this code and data), `stale` (stored rows made by other code, data or settings:
-    redone, or kept when `kept_stale`), `submitted`, `done`, `failed` (this run's), `wall_time_s` and `startup_s` (the wall time,
-    and the cluster's start and compile-cache warm-up before the first job [s]), `backend` (where
-    the jobs ran) and `workers` (how many ran at once)."""
+    redone, or kept when `kept_stale`), `submitted`, `done`, `failed` (this run's) and `failures`
+    (a line each, `jobs.failure_line`), `wall_time_s` and `startup_s` (the wall time, and the
+    cluster's start and warm-up before the first job [s]), `backend` and `workers` (how many at once)."""
 
     campaign: str
     jobs: int
@@ -56,6 +57,7 @@ class CampaignSummary:
     startup_s: float = 0.0
     stale: int = 0
     kept_stale: bool = False
+    failures: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -67,16 +69,6 @@ def _spec(spec: CampaignSpec | str | os.PathLike[str]) -> CampaignSpec:
 
 def _cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
-def _warm_up() -> None:
-    """Load (or compile) every kernel once here, before workers start: concurrent first
-    compilations of a cached numba function race (numba #10128)."""
-    from ..faults import HEALTHY
-    from ..identification.api import identify
-
-    identify(true_faults=HEALTHY, seed=0, pop_size=4, generations=1, polish=False, uncertainty="none",
-             workers=1)  # fmt: skip
 
 
 def run_campaign(
@@ -115,13 +107,14 @@ def run_campaign(
         if todo and serial:
             _run_serial(todo, collector.finished)
         elif todo:
-            backend, n_workers = _run_dask(todo, address, workers or cores, collector.finished, ready)
+            backend, n_workers = run_dask(todo, address, workers or cores, collector.finished, ready)
     finally:
         collector.flush(force=True)
     return CampaignSummary(
         campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo), stale=stale,
         kept_stale=keep_stale,
-        done=collector.done, failed=collector.failed, wall_time_s=round(time.perf_counter() - start, 3),
+        done=collector.done, failed=collector.failed, failures=tuple(collector.lines),
+        wall_time_s=round(time.perf_counter() - start, 3),
         backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
     )  # fmt: skip
 
@@ -165,6 +158,7 @@ class _Collector:
         self.failures: list[dict[str, Any]] = []
         self.done = 0
         self.failed = 0
+        self.lines: list[str] = []
         self.last_flush = time.monotonic()
 
     def flush(self, force: bool = False) -> None:
@@ -187,6 +181,7 @@ class _Collector:
         if failure is not None:
             self.failures.append(failure)
             self.failed += 1
+            self.lines.append(failure_line(failure))
         self.flush()
         if self.progress is not None:
             self.progress(self.done, self.failed, self.todo, time.perf_counter() - self.start)
@@ -202,99 +197,3 @@ def _run_serial(todo: list[Any], finished: Callable[[Any, Any], None]) -> None:
             finished(None, failure_row(payload, exc))
         else:  # outside the try: a failed store write is not this job's failure (review M2)
             finished(row, None)
-
-
-def _run_dask(
-    todo: list[Any],
-    address: str | None,
-    workers: int,
-    finished: Callable[[Any, Any], None],
-    ready: dict[str, float],
-) -> tuple[str, int]:
-    import dask
-    from distributed import Client, LocalCluster, as_completed
-
-    cluster = None
-    environ = dict(os.environ)  # Dask's nannies write their pre-spawn variables into ours: put back
-    if address is None:
-        _warm_up()
-        # one numba thread per worker (numba ignores the OMP_NUM_THREADS=1 Dask sets), and no
-        # statistical profiler: it samples every task thread every 10 ms, which slowed
-        # identifications by 11 % on 2 cores (BENCHMARKS.md, "Fleet campaigns")
-        with dask.config.set({
-            "distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": "1",
-            "distributed.worker.profile.enabled": False,
-            # the event loop's housekeeping wakes less often (it takes the GIL from the job)
-            "distributed.admin.tick.interval": "500ms",
-            "distributed.admin.system-monitor.interval": "2s",
-            "distributed.worker.memory.monitor-interval": "1s",
-        }):  # fmt: skip
-            cluster = LocalCluster(
-                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
-            )
-        client = Client(cluster)
-        backend = f"dask LocalCluster ({workers} workers x 1 thread)"
-    else:
-        try:
-            client = Client(address, timeout="10s")
-        except OSError as exc:
-            raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
-        workers = _checked_workers(client, address)
-        backend = f"dask scheduler {address} ({workers} workers)"
-    if cluster is not None:
-        try:
-            client.wait_for_workers(workers)
-        finally:
-            # the nannies set NUMBA_NUM_THREADS=1 (and OMP_*, PYTHONHASHSEED) in this process's
-            # environment to pass them to the workers; left there, numba's next compile here
-            # re-reads it and fails against the thread pool it launched with another count
-            _restore_environ(environ)
-    # each worker imports emaphm and loads the compiled kernels before the first job (2-3 s a
-    # process), so that jobs are timed and balanced on warm workers
-    client.run(_warm_up)
-    ready["at"] = time.perf_counter()
-    try:
-        payloads = {job.key: job.to_dict() for job in todo}
-        futures = [
-            client.submit(run_job, payload, key=f"emaphm-{key}", pure=False)
-            for key, payload in payloads.items()
-        ]
-        for future in as_completed(futures):
-            payload = payloads[str(future.key).removeprefix("emaphm-")]
-            try:
-                row = future.result()
-            except Exception as exc:  # the job's own error, or KilledWorker: recorded, the campaign goes on
-                finished(None, failure_row(payload, exc))
-            else:
-                finished(row, None)
-    except BaseException:
-        client.cancel(futures) if "futures" in locals() else None
-        raise
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-        _restore_environ(environ)
-    return backend, workers
-
-
-def _checked_workers(client: Any, address: str) -> int:
-    """The workers of a running cluster, each of which must run one job at a time (two jobs in one
-    process call numba's parallel kernels at once: review M3); `InputError` otherwise."""
-    threads = [int(w.get("nthreads", 1)) for w in client.scheduler_info().get("workers", {}).values()]
-    if any(n > 1 for n in threads):
-        client.close()
-        raise InputError(
-            f"the Dask workers at {address} run {max(threads)} threads each; emaphm needs one job per worker "
-            f"process: start them with 'NUMBA_NUM_THREADS=1 dask worker {address} --nthreads 1 --nworkers N'"
-        )
-    return max(1, len(threads))
-
-
-def _restore_environ(saved: dict[str, str]) -> None:
-    """Make `os.environ` what it was (`saved`)."""
-    for key in set(os.environ) - set(saved):
-        del os.environ[key]
-    for key, value in saved.items():
-        if os.environ.get(key) != value:
-            os.environ[key] = value

@@ -48,6 +48,7 @@ RESULT_COLUMNS: dict[str, str] = {
 }  # fmt: skip
 FAILURE_COLUMNS: dict[str, str] = {
     "job_key": "string", "flight": "int64", "seed": "int64", "error": "string", "message": "string",
+    "traceback": "string",  # the job's whole traceback (null in stores made before it)
     "worker": "string", "finished": "string", "version": "string",
 }  # fmt: skip
 PARTITIONS = ("campaign", "actuator")

@@ -13,6 +13,8 @@ from .render import print_campaign_status
 
 __all__ = ["campaign_app", "campaign_run", "campaign_status_command"]
 
+MAX_FAILURE_LINES = 20  # failed jobs listed a line each after a run; the rest are counted
+
 
 campaign_app = typer.Typer(
     help="Fleet campaigns: many identifications from one file, on Dask, into a results store (docs/campaigns.md).",
@@ -48,8 +50,8 @@ def campaign_run(
     A stored result made by other code, packaged data or settings (another fingerprint) is redone,
     unless --keep-stale; the latest result of a job is the one read.
 
-    Exit status 0 when every job is done, 1 when some failed (recorded in the store's failures;
-    a rerun tries them again).
+    Exit status 0 when every job is done, 1 when some failed: each is printed in one line, its
+    traceback recorded in the store's failures; a rerun tries them again.
     """
     import json
 
@@ -76,7 +78,14 @@ def campaign_run(
         kept = "kept (--keep-stale)" if summary.kept_stale else "redone"
         err.print(f"{summary.stale} stored result(s) were made by other code, data or settings: {kept}")
     if summary.failed:
-        err.print(f"emaphm: {summary.failed} job(s) failed: see 'emaphm campaign status {spec} {out}'")
+        for line in summary.failures[:MAX_FAILURE_LINES]:
+            err.print(f"emaphm: failed: {line}", soft_wrap=True)
+        more = summary.failed - MAX_FAILURE_LINES
+        err.print(
+            f"emaphm: {summary.failed} job(s) failed{f' ({more} more not shown)' if more > 0 else ''}; their "
+            f"tracebacks are in the store ({out}/failures, column traceback): see 'emaphm campaign status {spec} {out}'",
+            soft_wrap=True,
+        )
         raise typer.Exit(1)
 
 
