@@ -1,8 +1,10 @@
 """Campaign throughput on this machine: Dask LocalCluster vs a plain serial loop of the same jobs (issue 11).
 
     python benchmarks/bench_campaign.py [--jobs 16] [--tiny 60] [--case-seed 5101]
+    python benchmarks/bench_campaign.py --load 100000
 
-Smallest run (the smoke test): ``--jobs 2 --tiny 2 --pop-size 4 --generations 1 --no-polish``.
+Smallest run (the smoke test): ``--jobs 2 --tiny 2 --pop-size 4 --generations 1 --no-polish``,
+and ``--load 10``.
 Reported in BENCHMARKS.md, "Fleet campaigns".
 
 1. Throughput. --jobs random multi-fault actuators on the twin (DESIGN §7 ranges, the script's own
@@ -15,6 +17,12 @@ Reported in BENCHMARKS.md, "Fleet campaigns".
    intervals, a 0.2 s chirp) through the same campaign: (loop wall x workers - the jobs' own
    wall time) / jobs, the cluster's start excluded (target <= 50 ms).
 The estimates of both runs are compared (they must be identical).
+
+--load N instead times reading a campaign file of N actuators (one-off twin measurements, the
+script's seed), `load_campaign`, and making its jobs with their keys and fingerprints,
+`CampaignSpec.jobs()`, which `campaign run` and `campaign status` do before anything else (issue
+35's target: ≤ 5 s for 100 000 actuators). Printed: each of the two, best of 3, and the peak
+resident memory of the process.
 """
 
 from __future__ import annotations
@@ -40,13 +48,37 @@ def spec_file(folder: Path, name: str, cases: np.ndarray, identify: str = "") ->
     return path
 
 
+def load_time(n: int, seed: int) -> None:
+    """--load: the time to read a campaign file of n actuators and to make its jobs."""
+    import resource
+
+    print(machine_line(f"a campaign file of {n} actuators (seed {seed})"))
+    with tempfile.TemporaryDirectory() as name:
+        spec = spec_file(Path(name), "load", draw_cases(n, seed))
+        reads, makes = [], []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            campaign = load_campaign(spec)
+            t1 = time.perf_counter()
+            jobs = campaign.jobs()
+            reads.append(t1 - t0)
+            makes.append(time.perf_counter() - t1)
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"load_campaign: {min(reads):.2f} s; jobs(): {min(makes):.2f} s ({len(jobs)} jobs); "
+          f"together {min(reads) + min(makes):.2f} s (best of 3); peak memory {peak:.0f} MB")  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=16)
     parser.add_argument("--tiny", type=int, default=60)
     parser.add_argument("--case-seed", type=int, default=5101)
+    parser.add_argument("--load", type=int, default=None, help="time reading a campaign of N actuators instead")
     add_settings(parser)
     args = parser.parse_args(argv)
+    if args.load is not None:
+        load_time(args.load, args.case_seed)
+        return
     cores = len(os.sched_getaffinity(0))
     print(
         machine_line(f"{args.jobs} jobs (seed {args.case_seed}), {args.tiny} tiny jobs, {budget_text(args)}")

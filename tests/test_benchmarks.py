@@ -43,7 +43,7 @@ SMALLEST = {
     "bench_foc": [["--cases", "1", "--seeds", "1", "--healthy", "0", "--last-stage", "none", *TINY]],
     "uq_coverage": [["--cases", "2", "--healthy", "1", *TINY]],
     "bench_reader": [["--cases", "1", *TINY]],
-    "bench_campaign": [["--jobs", "2", "--tiny", "2", *TINY]],
+    "bench_campaign": [["--jobs", "2", "--tiny", "2", *TINY], ["--load", "10"]],
     "bench_rul_speed": [["--flights", "10", "--runs", "1"]],
 }
 NEEDS = {

@@ -56,9 +56,9 @@ def _number(v: Any) -> bool:
 def _vector(value: Any, name: str, where: str, *, faults: bool) -> tuple[float, ...]:
     if not isinstance(value, list) or len(value) != 8 or not all(_number(v) for v in value):
         raise _fail(where, f"{name} must be a list of 8 numbers, got {value!r}")
-    if faults:
-        try:
-            return tuple(float(v) for v in as_fault_vector(value, name=name))
+    if faults and not all(0.0 <= v <= 1.0 for v in value):
+        try:  # the one-line reason of the fault vector's own check
+            as_fault_vector(value, name=name)
         except InputError as exc:
             raise _fail(where, str(exc)) from None
     return tuple(float(v) for v in value)
