@@ -520,3 +520,13 @@ def test_an_foc_actuator_calibrates_and_identifies_from_the_shell(tmp_path, caps
                             str(Path(emaphm.__file__).parent / "data" / "calibration.json"),
                             "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)  # fmt: skip
     assert code == 2 and "a hysteresis drive, this one's is foc" in " ".join(err.split())
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".mat"])
+def test_a_rig_format_without_its_map_is_told_to_give_the_map(tmp_path, capsys, suffix):
+    # the newcomer: 'identify --reference x.parquet' without --map said Parquet was unsupported
+    rec = tmp_path / f"rig{suffix}"
+    rec.write_bytes(b"PAR1" if suffix == ".parquet" else b"MATLAB")
+    code, out, err = run_cli(["identify", "--reference", str(rec)], capsys)
+    message = " ".join(err.split())
+    assert code == 2 and out == "" and "give it with --map" in message and "unsupported" not in message

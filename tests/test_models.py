@@ -260,3 +260,19 @@ def test_a_recordings_grid_is_not_kept_alive_by_the_grid_cache():
     del monitor, command, t, theta
     gc.collect()
     assert gone() is None
+
+
+def test_an_actuator_files_path_serves_as_params_as_the_docs_say(tmp_path):
+    # the newcomer's §5.5: emaphm.simulate(params="actuator.toml") ended in an AttributeError
+    import emaphm
+    from emaphm.errors import InputError
+
+    path = tmp_path / "actuator.toml"
+    path.write_text("[motor]\nR_s = 0.6\n")
+    by_path = emaphm.simulate(params=path, duration=0.05, noise=False)
+    by_value = emaphm.simulate(params=emaphm.load_params(path), duration=0.05, noise=False)
+    assert np.array_equal(by_path.i_q, by_value.i_q)
+    assert by_path.metadata["params"]["motor"]["R_s"] == 0.6
+    assert emaphm.HighFidelityEma(str(path)).params.motor.R_s == 0.6
+    with pytest.raises(InputError, match="no such actuator file"):
+        emaphm.simulate(params=tmp_path / "missing.toml", duration=0.05)

@@ -45,6 +45,8 @@ __all__ = [
 ]
 
 TRACE_SUFFIXES = (".h5", ".hdf5", ".csv")
+# the rig formats the reader takes only with a channel map (`emaphm.measured`)
+RECORDING_ONLY_SUFFIXES = (".parquet", ".pq", ".mat")
 
 
 def side_file(path: Path) -> Path | None:
@@ -103,6 +105,11 @@ def check_trace_path(path: str | os.PathLike[str], *, for_writing: bool = True) 
     """Validate a trace path's extension; for writing as `check_output_path`, for reading that
     it is an existing file."""
     p = Path(path)
+    if not for_writing and p.suffix.lower() in RECORDING_ONLY_SUFFIXES:
+        raise InputError(
+            f"{p}: a {p.suffix.lower()} recording is read through a channel map: give it with --map MAP "
+            "(docs/your-actuator.md §3); a trace without one is an emaphm .h5 or .csv"
+        )
     if p.suffix.lower() not in TRACE_SUFFIXES:
         raise InputError(f"{p}: unsupported file type {p.suffix or '(none)'!r}; use .h5 or .csv")
     if for_writing:

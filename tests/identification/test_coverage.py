@@ -140,3 +140,17 @@ def test_a_staircase_logged_one_sample_late_is_still_the_calibrated_one():
     late = Steps()(np.clip(t - 1e-4, 0, None))
     assert command_warnings(t, late, CAL) == []
     assert command_warnings(t, Steps()(np.clip(t - 1e-2, 0, None)), CAL) != []  # 10 ms is another command
+
+
+def test_a_chirp_logged_at_500_hz_and_interpolated_is_still_the_calibrated_one():
+    # the newcomer's rig_reprise.mat: the chirp logged at 500 Hz, interpolated onto the 10 kHz grid,
+    # departs 2.3e-3 of its peak from the command, more than the 1e-3 tolerance: a false warning
+    t = np.arange(10001) / 1e4
+    knots = np.arange(501) / 500.0
+    logged = np.interp(t, knots, Chirp()(knots))
+    assert any("none of those" in r for r in command_warnings(t, logged, CAL))  # the rate unknown
+    assert command_warnings(t, logged, CAL, source_rate=500.0) == []  # its interpolation allowed for
+    # the allowance is the interpolation's error, not a licence: 10 % off at 500 Hz is flagged
+    assert any("none of those" in r for r in command_warnings(t, 1.1 * logged, CAL, source_rate=500.0))
+    # and at a rate as fast as the grid nothing is added
+    assert any("none of those" in r for r in command_warnings(t, logged, CAL, source_rate=1e4))

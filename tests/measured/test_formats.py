@@ -62,6 +62,27 @@ def test_csv_units_row_tab_and_decimal_comma(tmp_path):
     assert any("the file declares 'A'" in w for w in m.warnings)
 
 
+@pytest.mark.parametrize("units", [True, False])
+def test_csv_with_a_loggers_preamble_reads_as_without_it(tmp_path, twin, units):
+    # the newcomer's m13: two logger lines before the header gave "the file has: nothing"; the
+    # second has the data's width (a ';' inside it), the way a logger's date line does
+    c = twin_columns(twin)
+    plain = write_csv(tmp_path / "plain.csv", {"Zeit": c["t"] * 1e3, "Soll": np.rad2deg(c["theta_cmd"]),
+                                               "Lage": np.rad2deg(c["theta_u"]), "Strom": c["i_q"] * 1e3},
+                      delimiter=";")  # fmt: skip
+    lines = plain.read_text().splitlines()
+    head = ["Messsystem XY-400, Firmware 2.1", "Aufnahme 27.11.2026 08:00;Kanal 7;Prüfstand 2;frei"]
+    body = [lines[0], "ms;deg;deg;mA", *lines[1:]] if units else lines
+    logged = tmp_path / "logged.csv"
+    logged.write_text("\n".join(head + body) + "\n")
+    mapping = {"channels": {
+        "t": {"name": "Zeit", "unit": "ms"}, "theta_cmd": {"name": "Soll", "unit": "deg"},
+        "theta_u": {"name": "Lage", "unit": "deg"}, "i_q": {"name": "Strom", "unit": "mA"},
+    }}  # fmt: skip
+    ref = assert_same_reference(logged, mapping, twin)
+    assert ref.report["channels"]["i_q"]["samples"] == len(twin.t)
+
+
 def test_mat_v5_column_vectors(tmp_path, twin):
     from scipy.io import savemat
 

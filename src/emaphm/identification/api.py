@@ -23,6 +23,7 @@ from ..models import MonitorEma
 from ..params import EmaParams
 from ..results import SimResult
 from . import limits
+from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
 from .optimizers import OnGeneration
@@ -72,7 +73,9 @@ def identify(
         ident.fit(m.trace.t, m.trace.i_q, m.command, m.theta_u)
     warnings = [
         *(m.conversion or {}).get("warnings", []),
-        *recording_warnings(ident.context_, m.trace.t, m.trace.theta_cmd, monitor.calibration, thresholds),
+        *recording_warnings(
+            ident.context_, m.trace.t, m.trace.theta_cmd, monitor.calibration, thresholds, command_rate(m.conversion)
+        ),
     ]
     interval = None
     if factors is not None and explains(ident.fit_nrmse_):

@@ -12,44 +12,61 @@ result carries a warning instead of passing for a calibrated one.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.ndimage import maximum_filter1d
 
 from ..calibration import Calibration
 from ..commands import Command
 
-__all__ = ["COMMAND_TOLERANCE", "command_warnings"]
+__all__ = ["COMMAND_TOLERANCE", "command_rate", "command_warnings"]
 
 # the command may differ from the calibrated one by this fraction of its peak (sampling and
 # interpolation of a recorded command stay far below: ~1e-6 for a 10 Hz chirp at 3 kHz)
 COMMAND_TOLERANCE = 1e-3
 
 
-def _deviation(
-    times: NDArray[np.float64], theta: NDArray[np.float64], command: Command, step: float
-) -> tuple[float, float]:
-    """(largest |θ_cmd − command|, the command's peak) over the trace's times within the command.
+def _matches(
+    times: NDArray[np.float64], theta: NDArray[np.float64], command: Command, step: float, h: float
+) -> bool:
+    """Whether θ_cmd is `command` over the trace's times within the command.
 
-    The command may be shifted by up to one sample period `step` either way (a logger that stamps
-    the demand a sample early or late); the smallest deviation of the three counts.
+    At each sample |θ_cmd − command| may reach `COMMAND_TOLERANCE` of the command's peak, plus,
+    for a command logged every h [s] (> the trace's `step`) and interpolated linearly, that
+    interpolation's own error there, h²/8·|θ''| (the largest |θ''| within h of the sample). The
+    command may be shifted by up to one sample period `step` either way (a logger that stamps the
+    demand a sample early or late).
     """
     inside = times <= command.duration
     if not inside.any():
-        return math.inf, 0.0
-    best, peak = math.inf, 0.0
+        return False
     for shift in (0.0, -step, step):
         expected = np.asarray(command(np.clip(times[inside] - shift, 0.0, None)), dtype=np.float64)
-        best = min(best, float(np.max(np.abs(theta[inside] - expected))))
-        peak = max(peak, float(np.max(np.abs(expected))))
-    return best, peak
+        peak = float(np.max(np.abs(expected)))
+        allowed = np.full(len(expected), COMMAND_TOLERANCE * peak)
+        if h > step and len(expected) > 2:
+            curvature = np.zeros(len(expected))
+            curvature[1:-1] = np.abs(np.diff(expected, 2)) / step**2
+            window = 2 * math.ceil(h / step) + 1
+            allowed += h * h / 8.0 * maximum_filter1d(curvature, window, mode="nearest")
+        deviation = np.abs(theta[inside] - expected)
+        if np.all(deviation <= allowed) or (peak == 0.0 and not deviation.any()):
+            return True
+    return False
 
 
-def command_warnings(t: ArrayLike, theta_cmd: ArrayLike, calibration: Calibration) -> list[str]:
+def command_warnings(
+    t: ArrayLike, theta_cmd: ArrayLike, calibration: Calibration, source_rate: float | None = None
+) -> list[str]:
     """Reasons why a trace's command lies outside the calibration's commands; [] when it does not.
 
     t [s] starts the trace (shifted to 0 here), theta_cmd [rad] is its position command. The trace
-    is inside when one calibrated command lasts at least as long and matches it over the trace.
+    is inside when one calibrated command lasts at least as long and matches it over the trace:
+    within `COMMAND_TOLERANCE` of its peak, plus, for a command logged at `source_rate` [Hz] below
+    the trace's and interpolated onto it linearly, that interpolation's own error h²/8·max|θ''|
+    (h = 1/source_rate; a chirp logged at 500 Hz departs by 2.3e-3 of its peak).
     """
     commands = calibration.commands()
     if not commands:
@@ -70,10 +87,17 @@ def command_warnings(t: ArrayLike, theta_cmd: ArrayLike, calibration: Calibratio
     for command in commands.values():
         if span > float(command.duration) + step + 1e-9:
             continue
-        deviation, peak = _deviation(times, theta, command, step)
-        if deviation <= COMMAND_TOLERANCE * peak or (peak == 0.0 and deviation == 0.0):
+        h = 1.0 / source_rate if source_rate and source_rate > 0 else 0.0
+        if _matches(times, theta, command, step, h):
             return []
     return [
         f"the position command is none of those the monitor was calibrated on ({names}): "
         "the identification is not calibrated for it"
     ]
+
+
+def command_rate(conversion: dict[str, Any] | None) -> float | None:
+    """The rate [Hz] a recording's command was logged at (its conversion report); None for a trace."""
+    channel = (conversion or {}).get("channels", {}).get("theta_cmd") or {}
+    rate = channel.get("rate_hz")
+    return float(rate) if isinstance(rate, (int, float)) and rate > 0 else None

@@ -35,12 +35,13 @@ def recording_warnings(
     theta_cmd: Any,
     calibration: Calibration,
     thresholds: dict[str, float] | None,
+    command_rate: float | None = None,
 ) -> list[str]:
     """What the recording and the inputs leave doubtful: a command the monitor was not calibrated
     on, motion above the band, little data compared, thresholds measured with another monitor."""
     from .coverage import command_warnings
 
-    warnings = command_warnings(t, theta_cmd, calibration)
+    warnings = command_warnings(t, theta_cmd, calibration, command_rate)
     if context.above_band > 0:
         warnings.append(
             f"{100 * context.above_band:.0f} % of the recording commands motion faster than the "

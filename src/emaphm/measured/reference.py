@@ -61,7 +61,7 @@ class Reference:
 
 
 def to_reference(
-    measurement: Measurement, params: EmaParams | None = None, f_s: float | None = None
+    measurement: Measurement, params: EmaParams | str | os.PathLike[str] | None = None, f_s: float | None = None
 ) -> Reference:
     """Turn `measurement` into a reference trace on the model grid (see the module docstring).
 
@@ -69,8 +69,9 @@ def to_reference(
     ----------
     measurement : Measurement
         From `load_measurement`.
-    params : EmaParams, optional
-        The actuator (pole pairs, gear, I_max, theta_max, the grid's f_s); nominal by default.
+    params : EmaParams or path, optional
+        The actuator (pole pairs, gear, I_max, theta_max, the grid's f_s), or its actuator file;
+        nominal by default.
     f_s : float, optional
         Rate of the model grid [Hz]; ``params.controller.f_s`` by default.
 
@@ -83,7 +84,9 @@ def to_reference(
     InputError
         Implausible or unusable data, with the likely cause.
     """
-    params = params if params is not None else EmaParams()
+    from ..actuator import resolve_params
+
+    params = resolve_params(params)
     f_s = float(f_s if f_s is not None else params.controller.f_s)
     if not (math.isfinite(f_s) and f_s > 0):
         raise InputError(f"f_s must be a positive number of Hz, got {f_s!r}")

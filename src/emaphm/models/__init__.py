@@ -35,7 +35,7 @@ def simulate(
     model: str = "hf",
     noise: bool = True,
     seed: int = 0,
-    params: EmaParams | None = None,
+    params: EmaParams | str | os.PathLike[str] | None = None,
     command: Command | None = None,
     duration: float | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
@@ -55,7 +55,8 @@ def simulate(
     seed : int
         Seed of every random choice.
     params, command, duration
-        Override the nominal parameters, the FDI chirp, or its duration [s].
+        Override the nominal parameters (an `EmaParams` or an actuator file's path), the FDI
+        chirp, or its duration [s].
     calibration : Calibration or path, optional
         The monitor model's calibration (``model="lf"`` only; the packaged one by default).
     monitor : {"default", "paper"}, optional
@@ -68,7 +69,7 @@ def simulate(
 def make_model(
     model: str = "hf",
     *,
-    params: EmaParams | None = None,
+    params: EmaParams | str | os.PathLike[str] | None = None,
     command: Command | None = None,
     calibration: Calibration | str | os.PathLike[str] | None = None,
     monitor: str | None = None,
@@ -80,8 +81,8 @@ def make_model(
     ----------
     model : {"hf", "lf"}
         The fidelity.
-    params : EmaParams, optional
-        The actuator (default: the paper's nominal one).
+    params : EmaParams or path, optional
+        The actuator, or its actuator file (default: the paper's nominal one).
     command : Command, optional
         The position command (default: the FDI chirp).
     calibration : Calibration or path, optional

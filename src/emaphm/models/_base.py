@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from typing import Any
 
 import numpy as np
@@ -98,8 +99,12 @@ class _EmaModel:
 
     model = ""
 
-    def __init__(self, params: EmaParams | None = None, command: Command | None = None) -> None:
-        self.params = params if params is not None else EmaParams()
+    def __init__(
+        self, params: EmaParams | str | os.PathLike[str] | None = None, command: Command | None = None
+    ) -> None:
+        from ..actuator import resolve_params
+
+        self.params = resolve_params(params)  # an actuator file's path works as the docs say
         self.command = command if command is not None else Chirp()
 
     def sample_grid(self, duration: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

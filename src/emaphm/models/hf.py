@@ -58,8 +58,8 @@ class HighFidelityEma(_EmaModel):
 
     Parameters
     ----------
-    params : EmaParams
-        Nominal parameters (DESIGN §7).
+    params : EmaParams or path
+        The actuator, or its actuator file (default: the nominal parameters of DESIGN §7).
     command : Command
         Position command; the velocity-limited FDI chirp by default.
     """

@@ -116,8 +116,9 @@ class MonitorEma(_EmaModel):
 
     Parameters
     ----------
-    params : EmaParams
-        Nominal parameters: the LF model shares the drive train and controller with the HF twin.
+    params : EmaParams or path
+        The actuator, or its actuator file (default: nominal): the LF model shares the drive train
+        and controller with the HF twin.
     command : Command
         Position command; the FDI chirp by default.
     calibration : Calibration or path, optional
@@ -137,7 +138,7 @@ class MonitorEma(_EmaModel):
 
     def __init__(
         self,
-        params: EmaParams | None = None,
+        params: EmaParams | str | os.PathLike[str] | None = None,
         command: Command | None = None,
         calibration: Calibration | str | os.PathLike[str] | None = None,
         *,

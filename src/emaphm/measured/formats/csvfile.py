@@ -1,6 +1,7 @@
 """CSV text: what is accepted.
 
-- optional comment lines starting with ``#`` before the header;
+- optional comment lines starting with ``#`` before the header, and a logger's preamble: lines
+  before the header whose number of fields is not the data's (`preamble` counts them);
 - one header row of column names (quotes and surrounding spaces are stripped);
 - delimiter ``,``, ``;`` or tab, whichever the header row holds most of;
 - optionally one units row right after the header: every cell non-numeric (``A``, ``[mA]``,
@@ -42,6 +43,56 @@ def _number(cell: str) -> float | None:
         return None
 
 
+def _cells(line: str, delimiter: str) -> list[str]:
+    cells = [c.strip().strip('"') for c in next(csv.reader([line.rstrip("\r\n")], delimiter=delimiter))]
+    return cells[:-1] if len(cells) > 1 and not cells[-1] else cells  # a trailing delimiter
+
+
+def _is_data(line: str) -> tuple[bool, str]:
+    """Whether `line` is a row of numbers (or missing values) in two fields or more, and its delimiter."""
+    for delimiter in sorted(DELIMITERS, key=line.count, reverse=True):
+        cells = _cells(line, delimiter)
+        if len(cells) >= 2 and all(
+            c in MISSING or _number(c) is not None or _number(c.replace(",", ".")) is not None for c in cells
+        ):
+            return True, delimiter
+    return False, ","
+
+
+def _looks_like_units(line: str, delimiter: str) -> bool:
+    """Every cell a unit of the closed table (or ``-``), bare or in brackets: a units row."""
+    from ...units import UNITS
+
+    known = {u for table in UNITS.values() for u in table} | {"-", "rev", "kA", "counts", "V", "mm"}
+    return all(re.sub(r"^[\[(](.*)[\])]$", r"\1", c) in known for c in _cells(line, delimiter))
+
+
+def _past_preamble(head: list[str], k: int) -> tuple[int, int]:
+    """(the header's index, the number of preamble lines before it), from the first non-comment line k.
+
+    Of the lines with as many fields as the first data row that come right before it, the header
+    is the last one, or the one before it when that last one is a units row; the lines before the
+    header that are not comments are a logger's preamble. Without a data row in the first lines,
+    or with the header first, k itself.
+    """
+    rows = [i for i in range(k, len(head)) if head[i].strip() and not head[i].lstrip().startswith("#")]
+    first = next((i for i in rows if _is_data(head[i])[0]), None)
+    if first is None or first == rows[0]:
+        return k, 0
+    delimiter = _is_data(head[first])[1]
+    width = len(_cells(head[first], delimiter))
+    before = [i for i in rows if i < first]
+    block = []
+    for i in reversed(before):
+        if len(_cells(head[i], delimiter)) != width or len(block) == 2:
+            break
+        block.insert(0, i)
+    if not block:  # no line before the data has its width: no header to find
+        return k, 0
+    header = block[0] if len(block) == 2 and _looks_like_units(head[block[1]], delimiter) else block[-1]
+    return header, before.index(header)
+
+
 class CsvSource(Source):
     """A CSV file with a header row (see the module docstring)."""
 
@@ -63,6 +114,7 @@ class CsvSource(Source):
             k += 1
         if k == len(head):
             raise InputError(f"{path}: the file is empty (no header row)")
+        k, self.preamble = _past_preamble(head, k)
         header = head[k].rstrip("\r\n")
         self.delimiter = max(DELIMITERS, key=header.count)
         self.columns = [
