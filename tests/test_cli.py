@@ -497,6 +497,7 @@ def test_an_foc_actuator_calibrates_and_identifies_from_the_shell(tmp_path, caps
     record = json.loads(cal.read_text())
     assert "tau_i" not in record["settings"]["fitted"] and "i_D" not in record["settings"]["fitted"]
     assert record["settings"]["params"]["inverter"]["control"] == "foc"
+    assert record["quality"]["verdict"] in ("good", "usable", "poor")  # judged and recorded
     args = ["identify", "--params", str(actuator), "--calibration", str(cal), "--true-faults",
             "0.2,0,0,0.3,0,0,0,0.5", "--pop-size", "8", "--generations", "2", "--json"]  # fmt: skip
     code, out, err = run_cli(args, capsys)
@@ -530,3 +531,17 @@ def test_a_rig_format_without_its_map_is_told_to_give_the_map(tmp_path, capsys, 
     code, out, err = run_cli(["identify", "--reference", str(rec)], capsys)
     message = " ".join(err.split())
     assert code == 2 and out == "" and "give it with --map" in message and "unsupported" not in message
+
+
+def test_the_printed_diagnosis_names_the_actuator_and_calibrations_it_rests_on(tmp_path, capsys):
+    # the newcomer's m11: a recording of another actuator identified with the nominal one was
+    # silently off, and the output never said which actuator or calibration it used
+    code, out, _ = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--pop-size", "6",
+                            "--generations", "1", "--no-polish", "--uncertainty", "none"], capsys)  # fmt: skip
+    text = " ".join(out.split())
+    assert code in (0, 3)  # a tiny search: fitting or not, the inputs are named
+    assert "actuator: nominal (hash 9400227a7dd94ce8); monitor calibration: packaged (made 2026-" in text
+    path = tmp_path / "act.toml"
+    path.write_text("[motor]\nR_s = 0.6\n")
+    code, _, err = run_cli(["identify", "--params", str(path), "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)
+    assert code == 2 and "made for other actuator parameters" in err  # --params without its calibration

@@ -66,12 +66,17 @@ def calibrate(
             monitor=monitor, seed=seed, pop_size=pop_size, generations=generations, progress=update,
             params=actuator, free=names, start=held,
         )  # fmt: skip
+    from ..calibration.quality import judge, summary_lines
+
+    cal.record["quality"] = judge(cal.record)
     cal.save(output)
     for key, title in (("fit_scenarios", "fitted"), ("check_scenarios", "held out")):
         values = [s["nrmse"] for s in cal.record[key]]
         err.print(
             f"{title}: NRMSE {100 * min(values):.1f} to {100 * max(values):.1f} % over {len(values)} scenarios"
         )
+    for line in summary_lines(cal.record["quality"]):
+        err.print(line, soft_wrap=True)
     err.print(
         f"wrote {output} (seed {seed}, actuator {cal.params_hash}, {cal.record['settings']['wall_time_s']:.0f} s)"
     )

@@ -57,6 +57,19 @@ def print_identification(data: dict[str, Any]) -> None:
     out.print(
         f"fitness {data['fitness']:.4g}, {data['evaluations']} evaluations, {data['wall_time_s']:.1f} s"
     )
+    out.print(_inputs_line(data["settings"]), soft_wrap=True)
+
+
+def _inputs_line(settings: dict[str, Any]) -> str:
+    """Which actuator, monitor calibration and interval calibration the diagnosis rests on (a
+    recording of another actuator identified with the nominal one is otherwise silently off)."""
+    params, cal = settings.get("params") or {}, settings.get("calibration") or {}
+    uq = settings.get("uq_calibration")
+    line = (
+        f"actuator: {params.get('source', '?')} (hash {params.get('params_hash', '?')}); monitor calibration: "
+        f"{cal.get('source', '?')} (made {cal.get('created') or 'in code'})"
+    )
+    return line + (f"; intervals: {uq['source']}" if uq else "")
 
 
 def _second_search_line(second: dict[str, Any]) -> str:
