@@ -122,6 +122,28 @@ def test_given_offset_is_used(tmp_path, twin):
     assert band_nrmse(ref, twin) < NRMSE_TOL
 
 
+def test_an_offset_in_mechanical_degrees_is_questioned_and_its_kind_read(tmp_path, twin):
+    # the newcomer's m4b: a shaft encoder's 5 deg mechanical written where 20 deg electrical was
+    # meant passed silently and under-read a short by 20 %
+    c = twin_columns(twin)
+    path = write_phases(tmp_path / "m.csv", c, np.deg2rad(20.0))  # θ_e = angle + 20 deg (p = 4)
+    mapping = phase_map()
+    mapping["angle"] = {"offset": 5.0}
+    slip = to_reference(load_measurement(path, cmap(mapping)))
+    said = " ".join(slip.report["warnings"])
+    assert "reads as mechanical degrees" in said and 'kind = "mechanical"' in said
+    assert slip.report["angle"]["offset_estimate_deg"] == pytest.approx(20.0, abs=1.0)
+    mapping["angle"] = {"offset": 5.0, "kind": "mechanical"}
+    right = to_reference(load_measurement(path, cmap(mapping)))
+    assert not any("angle offset" in w for w in right.report["warnings"])
+    assert right.report["angle"]["offset_deg"] == pytest.approx(20.0) and band_nrmse(right, twin) < NRMSE_TOL
+    mapping["angle"] = {"offset": 40.0}  # simply wrong: questioned, and no unit slip suggested
+    wrong = " ".join(to_reference(load_measurement(path, cmap(mapping))).report["warnings"])
+    assert "40.0 deg (electrical) differs by 19.9 deg" in wrong and "mechanical" not in wrong
+    with pytest.raises(InputError, match=r"angle\.kind must be one of"):
+        cmap({**phase_map(), "angle": {"offset": 5.0, "kind": "shaft"}})
+
+
 def test_two_and_three_phases_give_the_same_iq(tmp_path, twin):
     c = twin_columns(twin)
     offset = np.deg2rad(42.0)

@@ -43,7 +43,7 @@ from ..errors import InputError
 from ..identification.signals import lowpass
 from ..kernels.transforms import clarke, park
 from ..params import EmaParams
-from .limits import ALIGNMENT_RESIDUAL_MAX, ZERO_SEQUENCE_MAX
+from .limits import ALIGNMENT_RESIDUAL_MAX, OFFSET_DISAGREE_DEG, ZERO_SEQUENCE_MAX
 
 __all__ = ["Alignment", "estimate_offset", "phases_to_iq", "torque_proxy"]
 
@@ -134,6 +134,29 @@ def _zero_sequence(
     return i_a, i_b, i_c
 
 
+def _questioned(given: float, estimated: float, params: EmaParams, report: dict[str, Any]) -> list[str]:
+    """A warning when the map's offset and the one the currents show differ by more than
+    `OFFSET_DISAGREE_DEG` (mod 180°: i_d² cannot tell the two), with the likely slip: mechanical
+    degrees written for electrical ones (the given value × p matches), or a wrong offset."""
+    def apart(a: float, b: float) -> float:
+        return abs((math.degrees(a - b) + 90.0) % 180.0 - 90.0)
+
+    report["offset_estimate_deg"] = math.degrees(estimated)
+    if apart(given, estimated) <= OFFSET_DISAGREE_DEG:
+        return []
+    p = params.motor.p
+    hint = (
+        f'it reads as mechanical degrees ({math.degrees(given):.1f} x {p} pole pairs matches): write [angle] kind = "mechanical"'
+        if apart(given * p, estimated) <= OFFSET_DISAGREE_DEG
+        else 'check it, or let emaphm estimate it (offset = "estimate")'
+    )
+    return [
+        f"the channel map's angle offset {math.degrees(given):.1f} deg (electrical) differs by "
+        f"{apart(given, estimated):.1f} deg from the one the currents show ({math.degrees(estimated) % 180:.1f} deg, "
+        f"mod 180): {hint}; the given one is used"
+    ]
+
+
 def phases_to_iq(
     t: NDArray[np.float64],
     i_a: NDArray[np.float64],
@@ -174,6 +197,7 @@ def phases_to_iq(
     else:
         theta0 = float(offset) % (2.0 * math.pi)
         report["offset_method"] = "given in the channel map"
+        warnings += _questioned(theta0, estimate_offset(i_alpha, i_beta, theta_e)[0], params, report)
     i_d, i_q = park(i_alpha, i_beta, theta_e + theta0)
     total = float(np.mean(i_d * i_d + i_q * i_q))
     residual = float(np.mean(i_d * i_d)) / total if total > 0 else 1.0

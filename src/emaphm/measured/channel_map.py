@@ -13,6 +13,7 @@ next-features §D.3 item 2: the mapping is a TOML file written by the user, neve
 
     [angle]                                      # optional
     offset = "estimate"                          # or a number: θ0 [deg] added to the angle
+    kind = "electrical"                          # the offset's degrees: "electrical" or "mechanical"
 
 Keys of a channel entry:
 
@@ -63,7 +64,8 @@ ROLES = tuple(KIND_OF_ROLE)
 ENTRY_KEYS = ("name", "unit", "scale", "fs", "t0", "time", "time_unit")
 TIME_ENTRY_KEYS = ("name", "unit", "scale")
 TOP_KEYS = ("channels", "angle")
-ANGLE_KEYS = ("offset",)
+ANGLE_KEYS = ("offset", "kind")
+OFFSET_KINDS = ("electrical", "mechanical")
 
 
 @dataclass(frozen=True)
@@ -109,12 +111,21 @@ class ChannelMap:
     channels : mapping  role (``t``, ``theta_cmd``, ``theta_u``, ``i_q``, ``i_a``, ``i_b``,
         ``i_c``, ``theta_e``, ``theta_m``) → `ChannelSpec`
     angle_offset_deg : float or None  θ0 [deg] added to the electrical angle; None: estimate it
+    angle_offset_kind : str  the degrees θ0 is given in: "electrical" (default) or "mechanical"
+        (a shaft encoder's data sheet; × pole pairs: `electrical_offset_deg`)
     where : str  where the map came from (a path), for messages
     """
 
     channels: Mapping[str, ChannelSpec]
     angle_offset_deg: float | None = None
+    angle_offset_kind: str = "electrical"
     where: str = field(default="channel map", compare=False)
+
+    def electrical_offset_deg(self, pole_pairs: int) -> float | None:
+        """θ0 in electrical degrees (a mechanical offset × `pole_pairs`); None: estimate it."""
+        if self.angle_offset_deg is None:
+            return None
+        return self.angle_offset_deg * (pole_pairs if self.angle_offset_kind == "mechanical" else 1)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> ChannelMap:
@@ -135,14 +146,15 @@ class ChannelMap:
             raise InputError(f"{where}: needs a [channels] table (theta_cmd and i_q or the phase currents)")
         _unknown(raw, ROLES, where, "[channels]", what="channel")
         channels = {role: _entry(role, entry, where) for role, entry in raw.items()}
-        offset = _angle_offset(data.get("angle", {}), where)
+        offset, kind = _angle_offset(data.get("angle", {}), where)
         _check_roles(channels, where)
-        return cls(channels=channels, angle_offset_deg=offset, where=where)
+        return cls(channels=channels, angle_offset_deg=offset, angle_offset_kind=kind, where=where)
 
     def to_dict(self) -> dict[str, Any]:
         """The TOML structure of this map (JSON-ready)."""
         out: dict[str, Any] = {"channels": {role: spec.to_dict() for role, spec in self.channels.items()}}
-        out["angle"] = {"offset": "estimate" if self.angle_offset_deg is None else self.angle_offset_deg}
+        out["angle"] = {"offset": "estimate" if self.angle_offset_deg is None else self.angle_offset_deg,
+                        "kind": self.angle_offset_kind}  # fmt: skip
         return out
 
     @property
@@ -231,16 +243,20 @@ def _entry(role: str, entry: Any, where: str) -> ChannelSpec:
     return ChannelSpec(name=name, unit=unit, scale=scale, fs=fs, t0=t0, time=time, time_unit=time_unit)
 
 
-def _angle_offset(table: Any, where: str) -> float | None:
+def _angle_offset(table: Any, where: str) -> tuple[float | None, str]:
+    """The [angle] table: (θ0 [deg] or None to estimate it, the kind of its degrees)."""
     if not isinstance(table, Mapping):
         raise InputError(f'{where}: [angle] must be a table, e.g. [angle] offset = "estimate"')
     _unknown(table, ANGLE_KEYS, where, "[angle]")
+    kind = table.get("kind", "electrical")
+    if kind not in OFFSET_KINDS:
+        raise InputError(f"{where}: angle.kind must be one of {', '.join(map(repr, OFFSET_KINDS))}, got {kind!r}")
     offset = table.get("offset", "estimate")
     if offset == "estimate":
-        return None
+        return None, kind
     if isinstance(offset, str):
         raise InputError(f'{where}: angle.offset must be "estimate" or a number of degrees, got {offset!r}')
-    return _number(offset, "angle.offset", where)
+    return _number(offset, "angle.offset", where), kind
 
 
 def _check_roles(channels: Mapping[str, ChannelSpec], where: str) -> None:

@@ -69,7 +69,8 @@ def grid_signals(
         i_c = current_at(runs["i_c"], t_cur) if "i_c" in m else None
         if "i_q" not in m:
             assert theta_e_run is not None  # the map requires an angle with the phase currents
-            offset = None if cmap.angle_offset_deg is None else math.radians(cmap.angle_offset_deg)
+            given = cmap.electrical_offset_deg(params.motor.p)
+            offset = None if given is None else math.radians(given)
             al = phases_to_iq(t_cur, i_a, i_b, i_c, np.interp(t_cur, *theta_e_run), params, offset=offset)
             warnings += al.warnings
             alignment_report = al.report
@@ -85,7 +86,7 @@ def grid_signals(
         for role, x in (("i_a", i_a), ("i_b", i_b), ("i_c", i_c)):
             signals[role] = on_grid(role, t_cur, x)
     if theta_e_run is not None:
-        theta0 = math.radians(alignment_report.get("offset_deg", cmap.angle_offset_deg or 0.0))
+        theta0 = math.radians(alignment_report.get("offset_deg", cmap.electrical_offset_deg(params.motor.p) or 0.0))
         signals["theta_e"] = on_grid("theta_e", theta_e_run[0], theta_e_run[1] + theta0)
     return signals, resampling, alignment_report, flags
 

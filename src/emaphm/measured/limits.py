@@ -17,6 +17,7 @@ __all__ = [
     "MIN_DURATION",
     "MIN_RATE_FAST",
     "MIN_RATE_SLOW",
+    "OFFSET_DISAGREE_DEG",
     "OUTLIER_FACTOR",
     "POSITION_FACTOR",
     "SATURATION_RUN",
@@ -39,6 +40,10 @@ SPREAD_FLOOR = 0.01  # the robust spread is at least this fraction of I_max or t
 SATURATION_RUN = 5  # equal samples at a channel's extreme: the sensor or ADC saturated
 ZERO_SEQUENCE_MAX = 0.05  # low-passed RMS(i_a + i_b + i_c) over the phase RMS (§D.3 item 6)
 ALIGNMENT_RESIDUAL_MAX = 0.25  # mean(i_d²)/mean(i_d² + i_q²) at the best θ0: the angle fits
+# [deg, electrical] a map's θ0 this far from the estimate is questioned: the estimate's own error is
+# 0.03-0.3° on the twin (bench_reader), and 5° mechanical written for 20° electrical under-read a
+# short by 20 % (the newcomer's m4b)
+OFFSET_DISAGREE_DEG = 3.0
 ANGLE_RATIO_TOLERANCE = 2.0  # std θ_e / std θ_u within a factor 2 of p·τ (twin: 0.99–1.23 over k1..k8)
 ANGLE_RATIO_TOLERANCE_CMD = 3.0  # against θ_cmd, which the loop tracks with lag (twin: 0.89–1.44)
 
