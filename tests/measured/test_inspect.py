@@ -92,3 +92,24 @@ def test_plausibility_of_native_traces(twin):
     assert (
         "is the time axis in seconds?" in plausibility(emaphm.SimResult(t=t * 1e3, signals=twin.signals))[0]
     )
+
+
+def test_a_surface_dwelling_at_its_peak_is_not_called_saturated_and_the_table_names_units(tmp_path, twin, capsys):
+    # the newcomer's note A: a false "saturated?" on a surface that sticks at its peak (friction),
+    # SI values under the file's unit, and a raw dict in the saturation cell
+    c = twin_columns(twin)
+    theta_u = c["theta_u"].copy()
+    peak = int(np.argmax(theta_u))
+    theta_u[peak : peak + 7] = theta_u[peak]  # stuck at the top for 7 samples
+    columns = {**{k: c[k] for k in SIGNALS}, "theta_u": theta_u, "i_q": c["i_q"] * 1e3}
+    path = write_csv(tmp_path / "stuck.csv", columns)
+    info = inspect_file(path, cmap(si_map(i_q={"name": "i_q", "unit": "mA"})))
+    assert info["channels"]["theta_u"]["saturation"]["run"] >= 7  # still in the table
+    assert not any("saturated" in w for w in info["warnings"])  # but no warning for a position
+    assert info["channels"]["i_q"]["si_unit"] == "A" and info["channels"]["i_q"]["unit"] == "mA"
+    from emaphm.cli.render import print_inspection
+
+    print_inspection(info)
+    out = " ".join(capsys.readouterr().out.split())
+    assert "file unit" in out and f"{c['i_q'].max():.4g} A" in out and "{'value'" not in out
+    assert "7 at the max" in out

@@ -107,29 +107,20 @@ def print_inspection(info: dict[str, Any]) -> None:
     out = stdout_console()
     out.print(f"{info['file']}: {info['format']}, {info.get('size_bytes', 0) / 1e6:.1f} MB")
     if info.get("channels"):
-        table = Table(title="mapped channels (SI)")
-        for column in (
-            "channel",
-            "name",
-            "unit",
-            "samples",
-            "rate [Hz]",
-            "duration [s]",
-            "min",
-            "max",
-            "saturation",
-        ):
-            table.add_column(
-                column, justify="left" if column in ("channel", "name", "unit", "saturation") else "right"
-            )
+        table = Table(title="mapped channels (min and max converted to SI)")
+        for column in ("channel", "name", "file unit", "samples", "rate [Hz]", "duration [s]", "min", "max",
+                       "equal samples at an extreme"):  # fmt: skip
+            table.add_column(column, justify="right" if column in ("samples", "rate [Hz]", "duration [s]") else "left")
         for role, ch in info["channels"].items():
+            si = f" {ch['si_unit']}" if ch.get("si_unit") else ""
+            sat = ch.get("saturation")
             table.add_row(
                 role, str(ch.get("name")), str(ch.get("unit")), str(ch.get("samples")),
                 f"{ch['rate_hz']:.6g}" if ch.get("rate_hz") else "-",
                 f"{ch['duration_s']:.4g}" if ch.get("duration_s") is not None else "-",
-                f"{ch['min_si']:.4g}" if ch.get("min_si") is not None else "-",
-                f"{ch['max_si']:.4g}" if ch.get("max_si") is not None else "-",
-                str(ch.get("saturation") or ""),
+                f"{ch['min_si']:.4g}{si}" if ch.get("min_si") is not None else "-",
+                f"{ch['max_si']:.4g}{si}" if ch.get("max_si") is not None else "-",
+                f"{sat['run']} at the {sat['at']} ({sat['value']:.4g}{si})" if sat else "",
             )  # fmt: skip
         out.print(table)
     else:

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..params import EmaParams
-from .channel_map import ChannelMap
+from ..units import KINDS
+from .channel_map import KIND_OF_ROLE, ChannelMap
 from .formats import open_source
 from .limits import SATURATION_RUN
 from .measurement import Channel, load_measurement
@@ -42,7 +43,8 @@ def _channel_summary(ch: Channel) -> dict[str, Any]:
     finite = ch.values[np.isfinite(ch.values)]
     return {
         "name": ch.name,
-        "unit": ch.unit,
+        "unit": ch.unit,  # the file's, as the map names it; min_si and max_si are in si_unit
+        "si_unit": KINDS[KIND_OF_ROLE[ch.role]] if ch.role in KIND_OF_ROLE else None,
         "samples": len(ch.values),
         "rate_hz": ch.f_s,
         "duration_s": float(finite_t[-1] - finite_t[0]) if len(finite_t) > 1 else 0.0,
@@ -112,9 +114,11 @@ def inspect_file(
     out["sha256"] = measurement.sha256
     out["channels"] = {role: _channel_summary(ch) for role, ch in measurement.channels.items()}
     for role, summary in out["channels"].items():
-        if summary["saturation"] is not None:
+        # a current's sensor or ADC clips; a position that dwells at its extreme is a surface that
+        # sticks there (friction holds it at the peak of the motion), not a saturated sensor
+        if summary["saturation"] is not None and role.startswith("i_"):
             s = summary["saturation"]
-            warnings.append(f"{role}: {s['run']} equal samples at its {s['at']} ({s['value']:g}): saturated?")
+            warnings.append(f"{role}: {s['run']} equal samples at its {s['at']} ({s['value']:g} A): saturated?")
     try:
         reference = to_reference(measurement, params)
     except InputError as exc:
