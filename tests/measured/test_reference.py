@@ -71,11 +71,12 @@ def test_time_gap_splits_without_interpolating_across(tmp_path, twin):
     keep[3000:3050] = False  # 5 ms without samples at 0.3 s
     path = write_csv(tmp_path / "gap.csv", {k: c[k][keep] for k in ("t", "theta_cmd", "theta_u", "i_q")})
     ref = to_reference(load_measurement(path, cmap(si_map())))
-    assert ref.report["segments"]["used"] == pytest.approx([0.305, 1.0])
+    # the stretch before the gap starts at rest in the command: preferred to the longer one after
+    assert ref.report["segments"]["used"] == pytest.approx([0.0, 0.2999])
     assert [g["kind"] for g in ref.report["segments"]["gaps"]] == [
         "gap"
     ] * 3  # one per channel on the time axis
-    assert close(ref.trace.i_q, twin.i_q[3050:])
+    assert close(ref.trace.i_q, twin.i_q[:3000])
 
 
 def test_report_is_json_and_survives_the_file(tmp_path, twin):

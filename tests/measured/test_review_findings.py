@@ -96,7 +96,10 @@ def test_a_gap_that_cuts_the_record_is_said_loudly(tmp_path, twin):
     report = to_reference(load_measurement(path, cmap(si_map()))).report
     assert "segment_cut" in report["flags"]
     (warning,) = [w for w in report["warnings"] if "split the record" in w]
-    assert "0.5..1 s (50 % of it)" in warning and "starts inside the command" in warning
+    # the stretch before the gap starts at rest in the command, the longer one after it does not:
+    # the one at rest is used (issue 34: the monitor starts at rest)
+    assert "0..0.3999 s (40 % of it)" in warning and "starts inside the command" not in warning
+    assert report["segments"]["used"] == pytest.approx([0.0, 0.3999])
 
 
 def test_values_with_units_round_to_the_number_meant():
@@ -110,3 +113,17 @@ def test_values_with_units_round_to_the_number_meant():
     assert a.motor.L_s == 0.0018 and params_hash(a) == params_hash(b)
     with pytest.raises(InputError, match=r'theta_max = "28\.6 deg"'):
         params_from_dict(tomllib.loads("theta_max = 28.6"))  # the hint names the unit meant
+
+
+@pytest.mark.parametrize("late", [0.10, 0.25, 0.75])
+def test_a_logger_started_after_the_motion_is_said_to_start_in_motion(tmp_path, twin, late):
+    # the newcomer's m5a/m5b: a logger triggered 0.10-0.75 s into the chirp gave a diagnosis with
+    # no word that the monitor's rest start does not hold
+    c = twin_columns(twin)
+    keep = c["t"] >= late
+    path = write_csv(tmp_path / "late.csv", {k: c[k][keep] for k in SIGNALS})
+    warnings = to_reference(load_measurement(path, cmap(si_map()))).report["warnings"]
+    assert any("starts in motion" in w for w in warnings)
+    # from rest it is not said
+    rest = write_csv(tmp_path / "rest.csv", {k: c[k] for k in SIGNALS})
+    assert not any("starts in motion" in w for w in to_reference(load_measurement(rest, cmap(si_map()))).report["warnings"])

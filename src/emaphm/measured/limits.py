@@ -20,6 +20,8 @@ __all__ = [
     "OFFSET_DISAGREE_DEG",
     "OUTLIER_FACTOR",
     "POSITION_FACTOR",
+    "REST_SPREAD",
+    "REST_WINDOW_S",
     "SATURATION_RUN",
     "SPREAD_FLOOR",
     "ZERO_SEQUENCE_MAX",
@@ -44,6 +46,12 @@ ALIGNMENT_RESIDUAL_MAX = 0.25  # mean(i_d²)/mean(i_d² + i_q²) at the best θ0
 # 0.03-0.3° on the twin (bench_reader), and 5° mechanical written for 20° electrical under-read a
 # short by 20 % (the newcomer's m4b)
 OFFSET_DISAGREE_DEG = 3.0
+# a recording starts at rest when its position command moves by at most REST_SPREAD of its whole
+# range over its first REST_WINDOW_S: the FDI chirp moves 0.26 % in its first 5 ms, 1.7 % at
+# 0.1 s into it and about 4 % from 0.25 s on; the monitor starts at rest (the newcomer's logger
+# started 0.10-0.75 s into the chirp)
+REST_WINDOW_S = 0.005
+REST_SPREAD = 0.01
 ANGLE_RATIO_TOLERANCE = 2.0  # std θ_e / std θ_u within a factor 2 of p·τ (twin: 0.99–1.23 over k1..k8)
 ANGLE_RATIO_TOLERANCE_CMD = 3.0  # against θ_cmd, which the loop tracks with lag (twin: 0.89–1.44)
 

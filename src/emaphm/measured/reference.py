@@ -41,7 +41,7 @@ from . import limits
 from .checks import angle_ratio, plausibility, span_problems, value_problems
 from .grid import Run, cut_run, grid_signals
 from .measurement import Channel, Measurement
-from .timebase import clean_runs, common_segment
+from .timebase import clean_runs, common_segment, starts_at_rest
 
 __all__ = ["FAST_ROLES", "Reference", "to_reference", "write_reference"]
 
@@ -101,6 +101,12 @@ def to_reference(
         seg, candidates = common_segment(channels, breaks)
     except InputError as exc:
         raise InputError(f"{src}: {exc}") from None
+    if not starts_at_rest(m["theta_cmd"], seg.start):
+        warnings.append(
+            f"the recording starts in motion: the position command moves in its first "
+            f"{1000 * limits.REST_WINDOW_S:g} ms (from {seg.start:.4g} s in the file), but the monitor starts at rest; "
+            "start the logger before the command, or the diagnosis may be off"
+        )
     runs = {ch.role: cut_run(ch, seg.runs[ch.role], seg.start, seg.end) for ch in channels}
     theta_e_run, angle_info = _angle(m, runs, params)  # 4. angle ratio
 

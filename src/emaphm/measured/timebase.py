@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .limits import GAP_FACTOR, MIN_DURATION
+from .limits import GAP_FACTOR, MIN_DURATION, REST_SPREAD, REST_WINDOW_S
 from .measurement import Channel
 
-__all__ = ["Breaks", "Segment", "clean_runs", "common_segment"]
+__all__ = ["Breaks", "Segment", "clean_runs", "common_segment", "starts_at_rest"]
 
 _LISTED = 5  # gaps named in a message
 
@@ -112,6 +112,12 @@ def common_segment(
         candidates = nxt
     segments = sorted((Segment(s, e, runs) for s, e, runs in candidates), key=lambda g: g.start)
     best = max(segments, key=lambda g: g.duration, default=None)
+    command = next((ch for ch in channels if ch.role == "theta_cmd"), None)
+    if best is not None and command is not None and not starts_at_rest(command, best.start):
+        # the monitor starts at rest: a stretch that starts at rest in the command is worth more
+        # than a longer one that starts in motion (the newcomer's 20 ms dropout mid-chirp)
+        resting = [g for g in segments if g.duration >= MIN_DURATION and starts_at_rest(command, g.start)]
+        best = max(resting, key=lambda g: g.duration, default=best)
     if best is None or best.duration < MIN_DURATION:
         gaps = [g for ch in channels for g in breaks[ch.role].gaps]
         listed = "; ".join(_describe(g) for g in gaps[:_LISTED]) + (
@@ -123,6 +129,18 @@ def common_segment(
             f"gaps: {listed or 'none'}"
         )
     return best, segments
+
+
+def starts_at_rest(command: Channel, start: float) -> bool:
+    """Whether the position command holds still over the first `REST_WINDOW_S` from `start`: it
+    moves by at most `REST_SPREAD` of its whole range there (a chirp at 3 ms moves 3 % of it)."""
+    finite = np.isfinite(command.values)
+    values, t = command.values[finite], command.t[finite]
+    span = float(np.ptp(values)) if len(values) else 0.0
+    window = values[(t >= start) & (t <= start + REST_WINDOW_S)]
+    if span == 0.0 or len(window) < 2:
+        return True
+    return float(np.ptp(window)) <= REST_SPREAD * span
 
 
 def _describe(g: dict[str, Any]) -> str:
