@@ -127,3 +127,20 @@ def test_a_logger_started_after_the_motion_is_said_to_start_in_motion(tmp_path, 
     # from rest it is not said
     rest = write_csv(tmp_path / "rest.csv", {k: c[k] for k in SIGNALS})
     assert not any("starts in motion" in w for w in to_reference(load_measurement(rest, cmap(si_map()))).report["warnings"])
+
+
+@pytest.mark.parametrize("kind", ["zeros", "held"])
+def test_a_dropout_logged_as_zeros_or_held_values_is_a_gap(tmp_path, twin, kind):
+    # the newcomer: dropouts logged as zeros or as held values were not seen as dropouts at all
+    c = twin_columns(twin)
+    i_q = c["i_q"].copy()
+    drop = (c["t"] >= 0.5) & (c["t"] < 0.52)  # 20 ms in the middle of the chirp
+    i_q[drop] = 0.0 if kind == "zeros" else i_q[np.argmax(drop) - 1]
+    path = write_csv(tmp_path / f"{kind}.csv", {**{k: c[k] for k in SIGNALS}, "i_q": i_q})
+    report = to_reference(load_measurement(path, cmap(si_map()))).report
+    said = " ".join(report["warnings"])
+    assert f"a dropout logged as {'zeros' if kind == 'zeros' else 'held values'}, treated as a gap" in said
+    assert report["segments"]["used"][1] < 0.5  # the stretch before it, which starts at rest
+    # a clean recording (noise on, or the surface at rest) has none
+    clean = write_csv(tmp_path / "clean.csv", {k: c[k] for k in SIGNALS})
+    assert not any("dropout" in w for w in to_reference(load_measurement(clean, cmap(si_map()))).report["warnings"])

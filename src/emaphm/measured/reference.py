@@ -25,6 +25,7 @@ The trace holds t (from 0), theta_cmd, i_q, theta_u when mapped, and i_a, i_b, i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from dataclasses import dataclass
@@ -41,7 +42,7 @@ from . import limits
 from .checks import angle_ratio, plausibility, span_problems, value_problems
 from .grid import Run, cut_run, grid_signals
 from .measurement import Channel, Measurement
-from .timebase import clean_runs, common_segment, starts_at_rest
+from .timebase import clean_runs, common_segment, frozen_runs, starts_at_rest
 
 __all__ = ["FAST_ROLES", "Reference", "to_reference", "write_reference"]
 
@@ -96,6 +97,7 @@ def to_reference(
     warnings = list(m.warnings)
     _check_channels(channels, params, src)  # 1. span and rates, 2. plausibility
 
+    channels = _dropouts_as_gaps(channels, m["theta_cmd"], warnings)
     breaks = {ch.role: clean_runs(ch) for ch in channels}  # 3. segments
     try:
         seg, candidates = common_segment(channels, breaks)
@@ -138,6 +140,27 @@ def to_reference(
     if problems:
         raise InputError(f"{src}: after conversion: {problems[0]}")
     return Reference(trace, report)
+
+
+def _dropouts_as_gaps(channels: list[Channel], command: Channel, warnings: list[str]) -> list[Channel]:
+    """The channels with each current's dropouts logged as zeros or held values (`frozen_runs`)
+    made NaN, so that they split the record like a gap; a warning names each channel's first one."""
+    out = []
+    for ch in channels:
+        runs = frozen_runs(ch, command)
+        if runs:
+            values = ch.values.copy()
+            for first, last in runs:
+                values[first : last + 1] = np.nan
+            a, b = runs[0]
+            warnings.append(
+                f"{ch.role} holds exactly {ch.values[a]:g} A for {1000 * (ch.t[b] - ch.t[a]):.3g} ms from {ch.row(a)} "
+                f"while the command moves: a dropout logged as {'zeros' if ch.values[a] == 0 else 'held values'}, "
+                f"treated as a gap ({len(runs)} such run(s))"
+            )
+            ch = dataclasses.replace(ch, values=values)
+        out.append(ch)
+    return out
 
 
 def _check_channels(channels: list[Channel], params: EmaParams, src: Any) -> None:

@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .limits import GAP_FACTOR, MIN_DURATION, REST_SPREAD, REST_WINDOW_S
+from .limits import FROZEN_MIN_S, FROZEN_MIN_SAMPLES, GAP_FACTOR, MIN_DURATION, REST_SPREAD, REST_WINDOW_S
 from .measurement import Channel
 
-__all__ = ["Breaks", "Segment", "clean_runs", "common_segment", "starts_at_rest"]
+__all__ = ["Breaks", "Segment", "clean_runs", "common_segment", "frozen_runs", "starts_at_rest"]
 
 _LISTED = 5  # gaps named in a message
 
@@ -129,6 +129,29 @@ def common_segment(
             f"gaps: {listed or 'none'}"
         )
     return best, segments
+
+
+def frozen_runs(ch: Channel, command: Channel) -> list[tuple[int, int]]:
+    """The runs (first, last sample) where a current channel holds exactly one value (zeros, or a
+    logger holding its last sample) for at least `FROZEN_MIN_S` and `FROZEN_MIN_SAMPLES` while the
+    position command moves by more than `REST_SPREAD` of its range: a dropout, since a measured
+    current carries noise and changes with the motion. [] for a channel that is not a current."""
+    if not ch.role.startswith("i_") or len(ch.values) < FROZEN_MIN_SAMPLES:
+        return []
+    v = ch.values
+    same = np.concatenate(([False], v[1:] == v[:-1], [False]))
+    edges = np.flatnonzero(np.diff(same.astype(np.int8)))
+    finite = np.isfinite(command.values)
+    span = float(np.ptp(command.values[finite])) if finite.any() else 0.0
+    runs = []
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        first, last = int(a), int(b)  # the run of equal values, v[first] == ... == v[last]
+        if last - first + 1 < FROZEN_MIN_SAMPLES or ch.t[last] - ch.t[first] < FROZEN_MIN_S:
+            continue
+        moving = command.values[(command.t >= ch.t[first]) & (command.t <= ch.t[last]) & finite]
+        if span > 0 and len(moving) > 1 and float(np.ptp(moving)) > REST_SPREAD * span:
+            runs.append((first, last))
+    return runs
 
 
 def starts_at_rest(command: Channel, start: float) -> bool:
