@@ -34,6 +34,7 @@ from emaphm.identification.fitness import Fitness
 from emaphm.identification.last_stage import SwitchingModel
 from emaphm.identification.limits import SECOND_SEARCH_NRMSE
 from emaphm.identification.problem import search_to_faults
+from emaphm.identification.recording import split_seed
 from emaphm.identification.settings import IdentifySettings
 from emaphm.identification.uncertainty import covers, laplace, load_factors
 from emaphm.kernels.monitor import N_AUX, simulate_lf, simulate_lf_many
@@ -99,8 +100,8 @@ def draw_cases(n: int, seed: int, absent: float = 0.0) -> np.ndarray:
 
 
 def noise_seed_of(seed: int) -> int:
-    """The twin's noise seed that ``identify(true_faults=..., seed=seed)`` uses."""
-    return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
+    """The twin's noise seed that ``identify(true_faults=..., seed=seed)`` uses (`split_seed`)."""
+    return split_seed(seed)[0]
 
 
 def measure(

@@ -17,7 +17,6 @@ identified with the nominal actuator and its packaged calibration.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import statistics
 
 import numpy as np
@@ -26,25 +25,8 @@ import emaphm
 from emaphm.faults import random_faults
 from emaphm.identification import last_stage
 from emaphm.identification.problem import search_to_faults
-
-
-def noise_seed_of(seed: int) -> int:
-    return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
-
-
-def toleranced(tolerance: float, seed: int) -> emaphm.EmaParams:
-    """The nominal actuator with its constants each within ±`tolerance` (a drawn unit)."""
-    rng = np.random.default_rng(seed)
-    base = emaphm.EmaParams()
-
-    def scaled(group: object, names: tuple[str, ...]) -> object:
-        return dataclasses.replace(group, **{n: getattr(group, n) * (1 + rng.uniform(-tolerance, tolerance)) for n in names})
-
-    return dataclasses.replace(
-        base,
-        motor=scaled(base.motor, ("R_s", "L_s", "psi_m")),
-        transmission=scaled(base.transmission, ("J_m", "J_u", "F_S0", "F_D0")),
-    )
+from emaphm.identification.recording import split_seed
+from emaphm.tolerances import drawn_actuator
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -76,8 +58,8 @@ def main(argv: list[str] | None = None) -> None:
         for s in range(1, args.seeds + 1):
             captured.clear()
             if args.tolerance > 0:
-                twin = emaphm.HighFidelityEma(toleranced(args.tolerance, 1000 * args.case_seed + c))
-            trace = twin.simulate(k, noise=True, seed=noise_seed_of(s))
+                twin = emaphm.HighFidelityEma(drawn_actuator(emaphm.EmaParams(), 1000 * args.case_seed + c, tolerance=args.tolerance))
+            trace = twin.simulate(k, noise=True, seed=split_seed(s)[0])
             emaphm.identify(reference=trace, seed=s, uncertainty="none")
             if not captured:
                 continue

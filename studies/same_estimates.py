@@ -13,16 +13,11 @@ from __future__ import annotations
 import argparse
 import json
 
-import numpy as np
-
 import emaphm
 from emaphm.faults import TABLE1_REFERENCE, random_faults
+from emaphm.identification.recording import split_seed
 
 FIELDS = ("estimate", "fitness", "fit_nrmse", "evaluations", "ci90_low", "ci90_high")
-
-
-def noise_seed_of(seed: int) -> int:
-    return int(np.random.SeedSequence(seed).spawn(2)[0].generate_state(1)[0])
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -33,7 +28,7 @@ def main(argv: list[str] | None = None) -> None:
     runs = {"table1_seed1": emaphm.identify(true_faults=TABLE1_REFERENCE, seed=1).to_json()}
     twin = emaphm.HighFidelityEma()
     for c, k in enumerate(random_faults(args.cases, 2611)):
-        trace = twin.simulate(k, noise=True, seed=noise_seed_of(1))
+        trace = twin.simulate(k, noise=True, seed=split_seed(1)[0])
         runs[f"case{c}"] = emaphm.identify(reference=trace, seed=1).to_json()
     out = {name: {f: data[f] for f in FIELDS} for name, data in runs.items()}
     with open(args.output, "w") as fh:

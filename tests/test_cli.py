@@ -453,20 +453,27 @@ def test_calibrate_detection_writes_thresholds_identify_can_load(tmp_path, capsy
     assert not (tmp_path / "no.json").exists()
 
 
+def tiny_calibration(tmp_path, capsys, monkeypatch, actuator_text):
+    """An actuator file of `actuator_text` and a one-generation calibration of it from the shell
+    (the polish's budget cut too, for the identifications that follow): their two paths."""
+    from emaphm.identification import limits
+
+    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
+    actuator = tmp_path / "actuator.toml"
+    actuator.write_text(actuator_text)
+    cal = tmp_path / "cal.json"
+    code, _, _ = run_cli(["calibrate", "--params", str(actuator), "--pop-size", "4", "--generations", "1",
+                          "--output", str(cal)], capsys)  # fmt: skip
+    assert code == 0
+    return actuator, cal
+
+
 @pytest.mark.slow  # a tiny calibration and identification of another actuator, ~3 s
 def test_an_8_khz_actuator_identifies_from_the_shell_with_the_switching_last_stage(tmp_path, capsys, monkeypatch):
     # review M1: fixed 2, 2.5, 1.25 us switching steps refused an 8 kHz actuator after the whole search
     import json
 
-    from emaphm.identification import limits
-
-    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
-    actuator = tmp_path / "act8k.toml"
-    actuator.write_text('[controller]\nf_s = "8 kHz"\n')
-    cal = tmp_path / "cal8k.json"
-    code, _, _ = run_cli(["calibrate", "--params", str(actuator), "--pop-size", "4", "--generations", "1",
-                          "--output", str(cal)], capsys)  # fmt: skip
-    assert code == 0
+    actuator, cal = tiny_calibration(tmp_path, capsys, monkeypatch, '[controller]\nf_s = "8 kHz"\n')
     code, out, _ = run_cli(["identify", "--params", str(actuator), "--calibration", str(cal), "--true-faults",
                               "0.2,0,0,0.3,0,0,0,0.5", "--pop-size", "8", "--generations", "2",
                               "--uncertainty", "none", "--json"], capsys)  # fmt: skip
@@ -484,16 +491,11 @@ def test_an_foc_actuator_calibrates_and_identifies_from_the_shell(tmp_path, caps
     # the actuator's own thresholds (a bad file refused in one line, before the work)
     import json
 
-    from emaphm.identification import limits
     from emaphm.identification.detection import DETECTABLE
 
-    monkeypatch.setattr(limits, "POLISH_BUDGET", (4, 1))
-    actuator = tmp_path / "foc.toml"
-    actuator.write_text('[inverter]\ncontrol = "foc"\nf_pwm = "20 kHz"\nK_p_i = "9.42 V/A"\n')
-    cal = tmp_path / "cal.json"
-    code, _, _ = run_cli(["calibrate", "--params", str(actuator), "--pop-size", "4", "--generations", "1",
-                          "--output", str(cal)], capsys)  # fmt: skip
-    assert code == 0
+    actuator, cal = tiny_calibration(
+        tmp_path, capsys, monkeypatch, '[inverter]\ncontrol = "foc"\nf_pwm = "20 kHz"\nK_p_i = "9.42 V/A"\n'
+    )
     record = json.loads(cal.read_text())
     assert "tau_i" not in record["settings"]["fitted"] and "i_D" not in record["settings"]["fitted"]
     assert record["settings"]["params"]["inverter"]["control"] == "foc"

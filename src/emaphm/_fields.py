@@ -15,7 +15,7 @@ from typing import Any
 
 from .errors import InputError
 
-__all__ = ["format_value"]
+__all__ = ["choice_problem", "format_value"]
 
 # the checks of a number field (metadata "check"); "choice" and "flag" fields are checked apart
 _CHECKS = {
@@ -44,6 +44,18 @@ def _flag(default: bool, symbol: str, doc: str) -> Any:
     return field(default=default, metadata={"symbol": symbol, "unit": "-", "doc": doc, "check": "flag"})
 
 
+def choice_problem(metadata: Any, value: Any, quote: Any = repr) -> str | None:
+    """What is wrong with `value` for a choice or flag field (its `metadata`), None if nothing or
+    if the field is a number: "must be one of …, got …" (each choice through `quote`) or "must be
+    true or false, got …". The dataclasses and the actuator file's reader word it alike."""
+    check = metadata["check"]
+    if check == "choice" and (not isinstance(value, str) or value not in metadata["choices"]):
+        return f"must be one of {', '.join(quote(c) for c in metadata['choices'])}, got {value!r}"
+    if check == "flag" and not isinstance(value, bool):
+        return f"must be true or false, got {value!r}"
+    return None
+
+
 def format_value(value: Any) -> str:
     """A parameter value as text: numbers with ``:g``, booleans as ``true``/``false``, strings as they are."""
     if isinstance(value, bool):
@@ -63,24 +75,18 @@ class _Validated:
             value = getattr(self, f.name)
             if isinstance(value, _Validated):
                 continue
-            check = f.metadata["check"]
-            if check == "choice":
-                choices = f.metadata["choices"]
-                if not isinstance(value, str) or value not in choices:
-                    allowed = ", ".join(repr(c) for c in choices)
-                    raise InputError(f"{name}.{f.name} must be one of {allowed}, got {value!r}")
-                continue
-            if check == "flag":
-                if not isinstance(value, bool):
-                    raise InputError(f"{name}.{f.name} must be true or false, got {value!r}")
+            if f.metadata["check"] in ("choice", "flag"):
+                problem = choice_problem(f.metadata, value)
+                if problem:
+                    raise InputError(f"{name}.{f.name} {problem}")
                 continue
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise InputError(f"{type(self).__name__}.{f.name} must be a number, got {value!r}")
+                raise InputError(f"{name}.{f.name} must be a number, got {value!r}")
             if not math.isfinite(value):
-                raise InputError(f"{type(self).__name__}.{f.name} must be finite, got {value!r}")
+                raise InputError(f"{name}.{f.name} must be finite, got {value!r}")
             ok, what = _CHECKS[f.metadata["check"]]
             if not ok(value):
-                raise InputError(f"{type(self).__name__}.{f.name} {what}, got {value!r}")
+                raise InputError(f"{name}.{f.name} {what}, got {value!r}")
         self._check()
 
     def _check(self) -> None:

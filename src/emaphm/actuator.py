@@ -29,6 +29,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+from ._fields import choice_problem
 from .errors import InputError
 from .failure import parse_thresholds
 from .params import MODE_KEYS, EmaParams
@@ -129,16 +130,10 @@ def _check_mode(control: str, raws: dict[str, Any], where: str) -> None:
 def _value(key: str, raw: Any, f: dataclasses.Field[Any], where: str) -> Any:
     """The value of one entry in its field's type: a choice as it is, a flag as it is, a number in
     SI (`to_si`) checked against `ACCEPTED`; `InputError` naming `where` and `key` otherwise."""
-    check = f.metadata["check"]
-    if check == "choice":
-        choices = f.metadata["choices"]
-        if not isinstance(raw, str) or raw not in choices:
-            allowed = ", ".join(f'"{c}"' for c in choices)
-            raise InputError(f"{where}: {key} must be one of {allowed}, got {raw!r}")
-        return raw
-    if check == "flag":
-        if not isinstance(raw, bool):
-            raise InputError(f"{where}: {key} must be true or false, got {raw!r}")
+    if f.metadata["check"] in ("choice", "flag"):  # as TOML writes them: choices in double quotes
+        problem = choice_problem(f.metadata, raw, quote=lambda c: f'"{c}"')
+        if problem:
+            raise InputError(f"{where}: {key} {problem}")
         return raw
     si_unit = f.metadata["unit"]
     value = to_si(raw, key, si_unit, where)

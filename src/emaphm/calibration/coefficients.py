@@ -190,7 +190,7 @@ def current_ripple(params: EmaParams) -> float:
     drive V_dc/(8·L_s·f_pwm), the largest peak-to-peak ripple of a centre-aligned PWM leg into the
     phase inductance (at duty ½)."""
     inv = params.inverter
-    if getattr(inv, "foc", False):
+    if inv.foc:
         return inv.V_dc / (8.0 * params.motor.L_s * inv.f_pwm)
     return inv.h
 

@@ -170,11 +170,11 @@ def calibrate_uq(
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
         raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
+    if not (isinstance(drive_tolerance, (int, float)) and 0.0 <= drive_tolerance < 1.0):
+        raise InputError(f"drive_tolerance must be in [0, 1), got {drive_tolerance!r}")
     actuator = resolve_params(params)
     lf = MonitorEma(actuator, calibration=calibration, monitor=monitor).calibration
     start = time.perf_counter()
-    if not (isinstance(drive_tolerance, (int, float)) and 0.0 <= drive_tolerance < 1.0):
-        raise InputError(f"drive_tolerance must be in [0, 1), got {drive_tolerance!r}")
     data = collect_cases(
         cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator,
         drive_tolerance=drive_tolerance,

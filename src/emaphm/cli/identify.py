@@ -85,16 +85,11 @@ def identify(
     from ..io import atomic_path
 
     settings = settings_from_options(options)
-    truth = _checked_inputs(
+    truth, thresholds = _checked_inputs(
         true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
         detection=detection,
     )  # fmt: skip
-    thresholds = None
-    if detection is not None:
-        from ..identification.detection import load_thresholds
-
-        thresholds = dict(load_thresholds(detection)["thresholds"])
     with progress() as update:
         result = run_identify(
             truth, reference, settings=settings, calibration=calibration, uq_calibration=uq_calibration,
@@ -134,10 +129,11 @@ def _checked_inputs(
     *, true_faults: str | None, reference: Path | None, map_file: Path | None, uncertainty: str,
     uq_calibration: Path | None, output: Path | None, report: Path | None, calibration: Path | None,
     params: Path | None, detection: Path | None = None,
-) -> Any:  # fmt: skip
+) -> tuple[Any, dict[str, float] | None]:  # fmt: skip
     """Every check of `identify`'s inputs and files, before the work (the settings are checked
-    when made, first): the truth or None. The input files, the output paths (none may be one of the
-    files read) and the interval calibration.
+    when made, first): the truth or None, and the detection thresholds of --detection or None. The
+    input files, the output paths (none may be one of the files read), the detection thresholds
+    and the interval calibration.
     """
     from ..faults import parse_faults
     from ..io import check_output_path, check_trace_path
@@ -161,14 +157,15 @@ def _checked_inputs(
         from ..report import check_report_dir
 
         check_report_dir(report)
+    thresholds = None
     if detection is not None:
         from ..identification.detection import load_thresholds
 
-        load_thresholds(detection)  # a bad file: refused before the work
+        thresholds = dict(load_thresholds(detection)["thresholds"])  # a bad file: refused before the work
     if uncertainty == "none" and uq_calibration is not None:
         raise InputError("--uq-calibration needs --uncertainty laplace or mcmc")
     if uncertainty != "none":
         from ..identification.uncertainty import load_factors
 
         load_factors(uq_calibration)  # a bad file: refused before the work
-    return truth
+    return truth, thresholds

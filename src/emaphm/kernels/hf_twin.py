@@ -249,6 +249,8 @@ def simulate_hf(theta_cmd, theta_noise, lsb_theta, fs_theta, cp, sp, mp, fp, dt,
             hi_a = i_q_ref * u_a + half_h
             hi_b = i_q_ref * u_b + half_h
             hi_c = i_q_ref * u_c + half_h
+            # the FOC drive's legs, then the same Euler step as below, written apart so that the
+            # hysteresis branches keep their operations (and results) as they were
             if foc:
                 t_now = n_step * dt
                 if t_now >= next_update - 1e-3 * dt:  # sample, PI, duties (foc.drive_update)

@@ -53,12 +53,12 @@ OFFSET_DISAGREE_DEG = 3.0
 # 0.1 s into it and about 4 % from 0.25 s on; the monitor starts at rest (the newcomer's logger
 # started 0.10-0.75 s into the chirp)
 REST_WINDOW_S = 0.005
+REST_SPREAD = 0.01
 # a current that holds exactly one value this long (and over this many samples) while the command
-# moves is a dropout logged as zeros or held values (the twin's currents, 12 bits and 20 mA of
-# noise, never repeat a value 10 times running)
+# moves is a dropout logged as zeros or held values (on the twin's chirp, 12 bits and 20 mA of
+# noise, no current repeats a value 10 times running while the command moves: tests/measured)
 FROZEN_MIN_S = 0.002
 FROZEN_MIN_SAMPLES = 10
-REST_SPREAD = 0.01
 ANGLE_RATIO_TOLERANCE = 2.0  # std θ_e / std θ_u within a factor 2 of p·τ (twin: 0.99–1.23 over k1..k8)
 ANGLE_RATIO_TOLERANCE_CMD = 3.0  # against θ_cmd, which the loop tracks with lag (twin: 0.89–1.44)
 

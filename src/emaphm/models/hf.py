@@ -31,10 +31,8 @@ FOC_STEP_FRACTION = 0.02
 def foc_pack(params: EmaParams) -> FocPack:
     """The FOC drive's run constants (`kernels.foc`) for `params`; on = 0 for a hysteresis drive."""
     inv, m = params.inverter, params.motor
-    if not getattr(inv, "foc", False):
-        return FocPack(
-            0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0
-        )
+    if not inv.foc:  # on = 0: the kernel reads none of the other fields
+        return FocPack._make(0.0 for _ in FocPack._fields)
     double = inv.update == "double"
     # update instants: the peaks at (j − φ)·T_pwm, with the valleys half a period later when double
     T_u = inv.T_update
@@ -85,7 +83,7 @@ class HighFidelityEma(_EmaModel):
         by orders of magnitude): `InputError`, instead of a silent hang.
         """
         integ = self.params.integration
-        if getattr(self.params.inverter, "foc", False):
+        if self.params.inverter.foc:
             # PWM: the volt-seconds of each step are exact (kernels.foc), so the sub-step only has
             # to resolve the stator's own dynamics: the fastest pair of phases in series
             pairs = ((sp.L_a + sp.L_b) / (sp.R_a + sp.R_b), (sp.L_b + sp.L_c) / (sp.R_b + sp.R_c),

@@ -50,7 +50,7 @@ def drive_fields(params: EmaParams, n_lf: int) -> dict[str, float]:
     voltage limit.
     """
     inv = params.inverter
-    if not getattr(inv, "foc", False):
+    if not inv.foc:
         return {"foc": 0.0, "K_p_i": 0.0, "K_i_i": 0.0, "n_u": 1.0, "delay": 0.0, "k_e_ff": 0.0, "V_lim": 0.0}
     dt_lf = 1.0 / (params.controller.f_s * n_lf)
     return {

@@ -44,19 +44,28 @@ def _number(cell: str) -> float | None:
 
 
 def _cells(line: str, delimiter: str) -> list[str]:
+    """The cells of one row, stripped of spaces and quotes, without a trailing empty one."""
     cells = [c.strip().strip('"') for c in next(csv.reader([line.rstrip("\r\n")], delimiter=delimiter))]
     return cells[:-1] if len(cells) > 1 and not cells[-1] else cells  # a trailing delimiter
 
 
-def _is_data(line: str) -> tuple[bool, str]:
-    """Whether `line` is a row of numbers (or missing values) in two fields or more, and its delimiter."""
+def _numeric(cell: str) -> bool:
+    """A number (``.`` or ``,`` as the decimal point) or a missing value."""
+    return cell in MISSING or _number(cell) is not None or _number(cell.replace(",", ".")) is not None
+
+
+def _bare_unit(cell: str) -> str:
+    """A units-row cell without its brackets: ``[mA]`` and ``(deg)`` are ``mA`` and ``deg``."""
+    return re.sub(r"^[\[(](.*)[\])]$", r"\1", cell)
+
+
+def _data_delimiter(line: str) -> str | None:
+    """The delimiter that makes `line` a row of numbers (or missing values) in two fields or more."""
     for delimiter in sorted(DELIMITERS, key=line.count, reverse=True):
         cells = _cells(line, delimiter)
-        if len(cells) >= 2 and all(
-            c in MISSING or _number(c) is not None or _number(c.replace(",", ".")) is not None for c in cells
-        ):
-            return True, delimiter
-    return False, ","
+        if len(cells) >= 2 and all(_numeric(c) for c in cells):
+            return delimiter
+    return None
 
 
 def _looks_like_units(line: str, delimiter: str) -> bool:
@@ -64,7 +73,7 @@ def _looks_like_units(line: str, delimiter: str) -> bool:
     from ...units import UNITS
 
     known = {u for table in UNITS.values() for u in table} | {"-", "rev", "kA", "counts", "V", "mm"}
-    return all(re.sub(r"^[\[(](.*)[\])]$", r"\1", c) in known for c in _cells(line, delimiter))
+    return all(_bare_unit(c) in known for c in _cells(line, delimiter))
 
 
 def _past_preamble(head: list[str], k: int) -> tuple[int, int]:
@@ -76,10 +85,10 @@ def _past_preamble(head: list[str], k: int) -> tuple[int, int]:
     or with the header first, k itself.
     """
     rows = [i for i in range(k, len(head)) if head[i].strip() and not head[i].lstrip().startswith("#")]
-    first = next((i for i in rows if _is_data(head[i])[0]), None)
-    if first is None or first == rows[0]:
+    found = next(((i, d) for i in rows if (d := _data_delimiter(head[i])) is not None), None)
+    if found is None or found[0] == rows[0]:
         return k, 0
-    delimiter = _is_data(head[first])[1]
+    first, delimiter = found
     width = len(_cells(head[first], delimiter))
     before = [i for i in rows if i < first]
     block = []
@@ -129,17 +138,9 @@ class CsvSource(Source):
         self.first_data_line = self.header_line + 1
         rest = [line for line in head[k + 1 :] if line.strip() and not line.lstrip().startswith("#")]
         if rest:
-            cells = [c.strip().strip('"') for c in next(csv.reader([rest[0]], delimiter=self.delimiter))]
-            if cells and not cells[-1]:
-                cells = cells[:-1]  # a trailing delimiter
-            if cells and all(
-                c and c not in MISSING and _number(c) is None and _number(c.replace(",", ".")) is None
-                for c in cells
-            ):
-                self.units = {
-                    name: re.sub(r"^[\[(](.*)[\])]$", r"\1", c)
-                    for name, c in zip(self.columns, cells, strict=False)
-                }
+            cells = _cells(rest[0], self.delimiter)
+            if cells and all(c and not _numeric(c) for c in cells):
+                self.units = {name: _bare_unit(c) for name, c in zip(self.columns, cells, strict=False)}
                 self.first_data_line = head.index(rest[0], k + 1) + 2
         self._cache: dict[str, Column] = {}
 
