@@ -52,6 +52,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--alpha", type=float, default=0.2)
     parser.add_argument("--lam", type=float, default=0.5)
     parser.add_argument("--estimator", default="trend", choices=("trend", "ukf"))
+    parser.add_argument("--include-doubtful", action="store_true", help='track "doubtful" diagnoses too')
     args = parser.parse_args(argv)
     progpy_model = load_progpy()
     pp_met, pp_ph, pp_cra = 0, [], []
@@ -65,7 +66,8 @@ def main(argv: list[str] | None = None) -> None:
             start, growth = act["start"][j], act["growth"][j]
             t_star = 1.0 + (threshold - start) / growth
             try:
-                report = rul_report(args.store, act["id"], thresholds=THRESHOLDS, estimator=args.estimator)
+                report = rul_report(args.store, act["id"], thresholds=THRESHOLDS, estimator=args.estimator,
+                                    include_doubtful=args.include_doubtful)  # fmt: skip
             except InputError as exc:  # a campaign not run to its end
                 print(f"{act['id']:>8} {fault:>9}  {exc}")
                 continue
@@ -77,7 +79,8 @@ def main(argv: list[str] | None = None) -> None:
             predictions, draws = {}, {}
             for flight in range(int(onset) + 1, last + 1):
                 r = rul_report(
-                    args.store, act["id"], at_flight=flight, thresholds=THRESHOLDS, estimator=args.estimator
+                    args.store, act["id"], at_flight=flight, thresholds=THRESHOLDS, estimator=args.estimator,
+                    include_doubtful=args.include_doubtful,
                 )
                 f = r["faults"][fault]
                 if f.get("rul_median") is not None:

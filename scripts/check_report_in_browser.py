@@ -55,7 +55,7 @@ def check(report: Path, screenshot: Path | None = None) -> list[str]:
         problems.append("the page's script did not run (no data-images-loaded)")
     elif loaded.group(1) != loaded.group(2) or loaded.group(2) == "0":
         problems.append(f"figures decoded: {loaded.group(1)} of {loaded.group(2)}")
-    if not re.search(r'class="verdict (fits|nofit)"', dom):
+    if not re.search(r'class="verdict (fits|doubt|nofit)"', dom):
         problems.append("no verdict in the rendered page")
     if "k1 friction" not in dom or "k8 kp_drift" not in dom:
         problems.append("the per-fault table is not in the rendered page")

@@ -10,7 +10,7 @@ import pytest
 import emaphm
 from emaphm import EmaParams, SensorParams
 
-__all__ = ["IDEAL", "RAMP", "faults", "frictionless", "run_cli"]
+__all__ = ["EXIT_OF_VERDICT", "IDEAL", "RAMP", "faults", "frictionless", "run_cli"]
 
 # ideal converters: tests of physical invariants should not see the ADC's quantisation
 IDEAL = EmaParams(sensors=SensorParams(bits_current=0, bits_position=0))
@@ -40,3 +40,7 @@ def run_cli(args, capsys):  # type: ignore[no-untyped-def]
         raise SystemExit(0)
     out = capsys.readouterr()
     return exc.value.code, out.out, out.err
+
+
+# `emaphm identify`'s exit status by verdict (emaphm/cli/__init__.py): a tiny search may end in any
+EXIT_OF_VERDICT = {"fits": 0, "doubtful": 4, "does not fit": 3}

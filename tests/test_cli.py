@@ -9,7 +9,7 @@ import pytest
 
 import emaphm
 from emaphm import read_trace
-from tests.helpers import run_cli
+from tests.helpers import EXIT_OF_VERDICT, run_cli
 
 
 @pytest.mark.parametrize(
@@ -206,8 +206,8 @@ def test_identify_json(tmp_path, capsys):
         ],
         capsys,
     )
-    assert code == 0
     data = json.loads(stdout)
+    assert code == EXIT_OF_VERDICT[data["verdict"]]
     for key in ("estimate", "fault_names", "truth", "percent_error", "fitness", "evaluations", "wall_time_s",
                 "seed", "optimizer", "version", "detected"):  # fmt: skip
         assert key in data
@@ -244,7 +244,7 @@ def test_identify_without_uncertainty_gives_null_intervals(capsys):
     )
     data = json.loads(stdout)
     assert (
-        code == 0
+        code == EXIT_OF_VERDICT[data["verdict"]]
         and data["uq_method"] == "none"
         and data["ci90_low"] is None
         and data["fault_verdicts"] is None
@@ -275,7 +275,7 @@ def test_identify_from_a_reference_trace(tmp_path, capsys):
     run_cli(["simulate", "--faults", "0,0.3,0,0,0,0,0,0.5", "--output", str(trace)], capsys)
     code, stdout, _ = run_cli(["identify", "--reference", str(trace), "--json", *FAST], capsys)
     data = json.loads(stdout)
-    assert code == 0 and data["truth"] is None and data["percent_error"] is None
+    assert code == EXIT_OF_VERDICT[data["verdict"]] and data["truth"] is None and data["percent_error"] is None
 
 
 def test_identify_says_what_the_switching_last_stage_did(capsys, monkeypatch):
@@ -318,10 +318,14 @@ def test_identify_says_when_a_poor_first_fit_started_a_second_search(capsys, mon
             "--generations", "2", "--last-stage", "none"]  # fmt: skip
     code, stdout, _ = run_cli(args, capsys)
     stdout = " ".join(stdout.split())  # the console wraps long lines
-    assert code == 0 and "second search: the first fit's NRMSE " in stdout and "x the first: " in stdout
+    # a search that needed its second start is doubtful (exit 4), and says why
+    assert code == 4 and "second search: the first fit's NRMSE " in stdout and "x the first: " in stdout
+    assert "verdict: doubtful" in stdout
     code, json_out, _ = run_cli([*args, "--json"], capsys)
-    record = stage_record(json.loads(json_out)["settings"]["stages"], "second_search")
-    assert code == 0 and record["trigger"] == 0.0 and record["first_fit_nrmse"] > 0.0
+    data = json.loads(json_out)
+    record = stage_record(data["settings"]["stages"], "second_search")
+    assert code == 4 and record["trigger"] == 0.0 and record["first_fit_nrmse"] > 0.0
+    assert any("second start" in d for d in data["doubts"])
     # the line says which result was kept, as the record does
     kept = "its result kept" if record["taken"] else "the first search's result kept"
     assert kept in stdout
@@ -479,7 +483,7 @@ def test_an_8_khz_actuator_identifies_from_the_shell_with_the_switching_last_sta
                               "--uncertainty", "none", "--json"], capsys)  # fmt: skip
     data = json.loads(out)
     switching = next(r for r in data["settings"]["stages"] if r["stage"] == "last_stage")["switching"]
-    assert code in (0, 3) and data["settings"]["last_stage"] == "switching"
+    assert code == EXIT_OF_VERDICT[data["verdict"]] and data["settings"]["last_stage"] == "switching"
     for step in switching["steps_s"]:  # whole fractions of the 125 us sample period
         assert 125e-6 / step == pytest.approx(round(125e-6 / step), abs=1e-9)
 
@@ -504,7 +508,7 @@ def test_an_foc_actuator_calibrates_and_identifies_from_the_shell(tmp_path, caps
             "0.2,0,0,0.3,0,0,0,0.5", "--pop-size", "8", "--generations", "2", "--json"]  # fmt: skip
     code, out, err = run_cli(args, capsys)
     data = json.loads(out)
-    assert code in (0, 3)
+    assert code == EXIT_OF_VERDICT[data["verdict"]]
     warned = " ".join(data["warnings"])
     assert "detection thresholds were measured on another actuator" in warned and "foc drive" in warned
     assert "interval calibration was fitted with another LF calibration" in warned
@@ -541,7 +545,7 @@ def test_the_printed_diagnosis_names_the_actuator_and_calibrations_it_rests_on(t
     code, out, _ = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--pop-size", "6",
                             "--generations", "1", "--no-polish", "--uncertainty", "none"], capsys)  # fmt: skip
     text = " ".join(out.split())
-    assert code in (0, 3)  # a tiny search: fitting or not, the inputs are named
+    assert code in (0, 3, 4)  # a tiny search: fitting or not, the inputs are named
     assert "actuator: nominal (hash 9400227a7dd94ce8); monitor calibration: packaged (made 2026-" in text
     path = tmp_path / "act.toml"
     path.write_text("[motor]\nR_s = 0.6\n")

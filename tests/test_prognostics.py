@@ -162,3 +162,29 @@ def test_the_most_likely_fault_counts_only_the_draws_in_which_one_fails():
     never = np.full((2, 100), inf)
     never[0, :10] = 5.0
     assert most_likely_fault(["friction", "backlash"], never) is None  # most draws never fail
+
+
+def test_doubtful_diagnoses_are_left_out_of_the_trend_unless_asked_and_counted(tmp_path, capsys):
+    # issue 34: a doubtful diagnosis (its fit poorer than the actuator's usual, a precondition not
+    # met) must not move the RUL unless asked for; how many were left out is said
+    flights = np.arange(1, 21)
+    rows = _rows("A1", flights, 0.05 + 0.01 * flights, 0.005, detected_from=1)
+    for n in (15, 16, 17):  # three doubtful diagnoses that say the friction jumped
+        rows[n - 1].update(verdict="doubtful", k1=0.9)
+    ResultStore(tmp_path).write("results", rows)
+    sure = rul_report(tmp_path, "A1", thresholds={"friction": 0.45})
+    f = sure["faults"]["friction"]
+    assert sure["doubtful_left_out"] == 3 and sure["include_doubtful"] is False and f["measurements"] == 17
+    assert f["rul_median"] == pytest.approx(20, abs=1.0) and sure["at_flight"] == 20
+    every = rul_report(tmp_path, "A1", thresholds={"friction": 0.45}, include_doubtful=True)
+    assert every["doubtful_left_out"] == 0 and every["faults"]["friction"]["measurements"] == 20
+    assert every["faults"]["friction"]["rul_median"] < f["rul_median"] - 3  # the jump pulls the crossing in
+    args = ["rul", str(tmp_path), "--actuator", "A1", "--threshold", "friction=0.45"]
+    code, out, _ = run_cli(args, capsys)
+    assert code == 0 and "3 doubtful diagnoses left out" in out and "--include-doubtful" in out
+    code, out, _ = run_cli([*args, "--include-doubtful", "--json"], capsys)
+    assert code == 0 and json.loads(out)["doubtful_left_out"] == 0
+    # nothing sure left: refused in one line, naming the way out
+    ResultStore(tmp_path / "d").write("results", [{**r, "verdict": "doubtful"} for r in _rows("B", flights[:3], [0.1] * 3, 0.005, 1)])
+    code, _, err = run_cli(["rul", str(tmp_path / "d"), "--actuator", "B"], capsys)
+    assert code == 2 and "all 3 diagnoses" in err and "--include-doubtful" in err and err.count("\n") == 1

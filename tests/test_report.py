@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import os
 import re
 import shutil
 import sys
@@ -53,7 +54,9 @@ def test_a_report_shows_the_verdict_faults_and_figures_and_needs_nothing_else(me
     assert sorted(p.name for p in (tmp_path / "rep").iterdir()) == sorted(REPORT_FILES)
     parsed = _read(page)
     text = " ".join(parsed.text)
-    assert "fits: detected" in text and "does not fit" not in text
+    # a 16 x 10 search without polish may fit less well than the twin's usual: then doubtful, with its reasons
+    assert result.verdict in ("fits", "doubtful") and f"{result.verdict}: detected" in text and "does not fit" not in text
+    assert all(d in text for d in result.doubts)
     for i, name in enumerate(emaphm.FAULT_NAMES, start=1):
         assert f"k{i} {name}" in text
     assert '<td class="present">' in page.read_text()
@@ -120,15 +123,19 @@ def test_cli_report_and_a_bad_report_path(measured, tmp_path, capsys):
     emaphm.write_trace(measured, path)
     args = ["identify", "--reference", str(path), "--pop-size", "16", "--generations", "3", "--no-polish"]
     code, _, err = run_cli([*args, "--report", str(tmp_path / "rep")], capsys)
-    assert code == 0 and (tmp_path / "rep" / "index.html").is_file() and "wrote the report" in err
+    assert code in (0, 4) and (tmp_path / "rep" / "index.html").is_file() and "wrote the report" in err
     assert emaphm.io.sha256_of(path) in (tmp_path / "rep" / "index.html").read_text()
     (tmp_path / "afile").write_text("x")
     code, out, err = run_cli([*args, "--report", str(tmp_path / "afile")], capsys)
     assert code == 2 and out == "" and "not a folder" in err and err.count("\n") == 1
 
 
-@pytest.mark.skipif(shutil.which("chromium") is None, reason="no headless Chromium (apt install chromium)")
+@pytest.mark.skipif(
+    shutil.which("chromium") is None and not os.environ.get("EMAPHM_REQUIRE_BROWSER"),
+    reason="no headless Chromium (apt install chromium); .ci/run installs it and requires this test",
+)
 def test_the_report_renders_in_a_real_headless_browser(measured, tmp_path):
+    assert shutil.which("chromium"), "EMAPHM_REQUIRE_BROWSER is set but chromium is not installed"
     sys.path.insert(0, str(ROOT / "scripts"))
     try:
         from check_report_in_browser import check

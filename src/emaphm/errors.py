@@ -8,7 +8,13 @@ one-line reason); anything else is a failure (exit status 1).
 
 from __future__ import annotations
 
-__all__ = ["InputError", "SimulationError"]
+__all__ = ["Doubt", "InputError", "SimulationError"]
+
+
+class Doubt(str):
+    """A warning that makes a diagnosis doubtful: a precondition of it not met (the recording
+    starts in motion, the given angle offset disagrees with the currents, ...). It is a warning
+    like any other; `identify` reports a result with one as verdict "doubtful"."""
 
 
 class InputError(ValueError):

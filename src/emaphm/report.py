@@ -121,7 +121,7 @@ h1{font-size:1.4em} h2{font-size:1.1em;margin-top:1.6em;border-bottom:1px solid 
 table{border-collapse:collapse;font-size:.9em} td,th{border:1px solid #ccc;padding:.25em .6em}
 td.num{text-align:right;font-variant-numeric:tabular-nums} th{background:#f3f3f3}
 .verdict{display:inline-block;padding:.3em .8em;border-radius:4px;font-weight:bold}
-.fits{background:#e3f4e3;color:#1d5e1d} .nofit{background:#fbe3e3;color:#8a1c1c}
+.fits{background:#e3f4e3;color:#1d5e1d} .nofit{background:#fbe3e3;color:#8a1c1c} .doubt{background:#fff0cc;color:#6b4a00}
 .present{font-weight:bold;color:#8a1c1c} .warn{background:#fff6dd;padding:.5em 1em;border-left:4px solid #e0b000}
 img{max-width:100%;border:1px solid #eee} pre{background:#f7f7f7;padding:.8em;overflow-x:auto;font-size:.8em}
 """
@@ -137,13 +137,15 @@ def _page(data: dict[str, Any], figures: dict[str, bytes], provenance: dict[str,
     from .tables import fault_rows
 
     e = html.escape
-    fits = data["verdict"] == "fits"
     detected = ", ".join(data["detected"]) or "none (healthy)"
-    headline = (
-        f'<span class="verdict fits">fits: detected {e(detected)}</span>'
-        if fits
-        else '<span class="verdict nofit">does not fit: the model does not explain this recording; '
-        "no faults are reported</span>"
+    headline = {
+        "fits": f'<span class="verdict fits">fits: detected {e(detected)}</span>',
+        "doubtful": f'<span class="verdict doubt">doubtful: detected {e(detected)}, but '
+        f"{len(data.get('doubts') or [])} reason(s) below say why this may not be a diagnosis</span>",
+    }.get(
+        data["verdict"],
+        '<span class="verdict nofit">does not fit: the model does not explain this recording; '
+        "no faults are reported</span>",
     )
     numbers = [
         ("fit NRMSE", "-" if data["fit_nrmse"] is None else f"{100 * data['fit_nrmse']:.2f} %"),

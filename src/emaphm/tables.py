@@ -39,7 +39,7 @@ def fault_rows(data: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
             ]
         if data["truth"] is not None:
             row.append(f"{data['truth'][i]:.4f}")
-        if data["verdict"] != "fits":
+        if data["verdict"] == "does not fit":
             row.append("-")
         elif verdicts:
             row.append(verdicts.get(name, "(direction)"))

@@ -267,6 +267,8 @@ def test_a_campaign_job_gives_the_estimate_of_a_lone_identification(tmp_path):
         alone = emaphm.identify(true_faults=k, seed=row["identify_seed"], pop_size=6, generations=2,
                                 polish=False, uncertainty="none")  # fmt: skip
         assert [row[f"k{i}"] for i in range(1, 9)] == alone.estimate.tolist()
+        # and its verdict with the reasons for it (a 6 x 2 search fits poorly: doubtful)
+        assert row["verdict"] == alone.verdict and json.loads(row["doubts"]) == alone.doubts
 
 
 @pytest.mark.slow  # ~3-4 s: a local dask cluster started and stopped

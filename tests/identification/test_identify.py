@@ -134,9 +134,13 @@ def test_identify_records_what_it_did():
     assert data["percent_error"] == percent_error(res.estimate, [0.3, 0, 0, 0, 0, 0, 0, 0.5])
     # the shipped thresholds, applied to the estimate, when the monitor explains the measurement;
     # a 16 x 3 search without polish may not (then the verdict says so and nothing is reported)
-    assert data["verdict"] == ("fits" if data["fit_nrmse"] <= 0.5 else "does not fit")
+    # (a fit poorer than the actuator's usual is "doubtful": its faults are reported, with the reason)
+    limit = data["settings"]["doubtful_above"]["nrmse"]
+    assert data["verdict"] == ("does not fit" if data["fit_nrmse"] > 0.5 else "doubtful" if data["fit_nrmse"] > limit
+                               else "fits")  # fmt: skip
+    assert (data["verdict"] == "doubtful") == bool(data["doubts"]) and set(data["doubts"]) <= set(data["warnings"])
     # by the intervals' verdicts when there are intervals, by the point rule when there are none
-    if data["verdict"] != "fits":
+    if data["verdict"] == "does not fit":
         assert data["detected"] == []
     elif res.uncertainty is None:
         assert data["detected"] == detect(res.estimate)

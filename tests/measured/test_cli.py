@@ -85,7 +85,9 @@ def test_identify_reads_a_recording_through_its_map(rig, capsys):
             "--pop-size", "16", "--generations", "3", "--no-polish", "--uncertainty", "none"]  # fmt: skip
     code, out, _ = run_cli(args, capsys)
     data = json.loads(out)
-    assert code == 0 and data["verdict"] == "fits"
+    # a 16 x 3 search fits poorly: doubtful (exit 4) for that reason alone, the recording being clean
+    assert code == 4 and data["verdict"] == "doubtful" and data["fit_nrmse"] > data["settings"]["doubtful_above"]["nrmse"]
+    assert "explained less well" in data["doubts"][0] and set(data["doubts"]) <= set(data["warnings"])
     conversion = data["settings"]["conversion"]
     assert abs((conversion["angle"]["offset_deg"] - OFFSET_DEG + 180) % 360 - 180) < 1.0
     assert conversion["source"]["sha256"] == sha256_of(rig / "rig.csv")

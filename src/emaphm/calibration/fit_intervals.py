@@ -30,6 +30,7 @@ from ..actuator import resolve_params
 from ..errors import InputError
 from ..faults import random_faults
 from ..identification.uncertainty import FIT_COVERAGE, Factors, fit_factors
+from ..identification.verdict import fit_distribution
 from ..models import MonitorEma
 from ..models._base import check_seed
 from ..params import EmaParams
@@ -63,8 +64,8 @@ def collect_cases(
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
-    "raw_std"} arrays (one row per case) and "skipped", the cases the monitor could not explain.
-    The draws do not depend on `cases`, so a longer set extends a shorter one, and `first` resumes
+    "raw_std", "fit_nrmse"} arrays (one row per case) and "skipped", the cases the monitor could not
+    explain. The draws do not depend on `cases`: a longer set extends a shorter one, `first` resumes
     one. Of an FOC drive with `drive_tolerance` > 0, each case's twin is drawn about `params`
     (`tolerances.drawn_actuator`: the PI gains within ±drive_tolerance, the carrier's phase).
 
@@ -95,7 +96,8 @@ def collect_cases(
     actuator = params if params is not None else EmaParams()
     drawn = actuator.inverter.foc and drive_tolerance > 0
     K = random_faults(cases, seed, absent=absent)[first:]
-    kept, estimates, raw, walls, skipped = [], [], [], [], []
+    kept: list[tuple[Any, ...]] = []  # (truth, estimate, raw σ, fit NRMSE) of each usable case
+    walls, skipped = [], []
     for i, k in enumerate(K, start=first):
         run_seed = 1000 * seed + i
         source: dict[str, Any] = {"true_faults": k}
@@ -109,9 +111,7 @@ def collect_cases(
         if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
             skipped.append({"case": i, "faults": k.tolist(), "fit_nrmse": r.fit_nrmse})
         else:
-            kept.append(k)
-            estimates.append(r.estimate)
-            raw.append(r.uncertainty.raw_std)
+            kept.append((k, r.estimate, r.uncertainty.raw_std, r.fit_nrmse))
         walls.append(r.wall_time_s)
         if progress is not None:
             progress("identifications", i + 1, cases)
@@ -122,9 +122,11 @@ def collect_cases(
         )
     rows = (len(kept), K.shape[1])
     return {
-        "truths": np.array(kept).reshape(rows),
-        "estimates": np.array(estimates).reshape(rows),
-        "raw_std": np.array(raw).reshape(rows),
+        **{
+            name: np.array([c[j] for c in kept]).reshape(rows)
+            for j, name in enumerate(("truths", "estimates", "raw_std"))
+        },
+        "fit_nrmse": np.array([c[3] for c in kept], dtype=np.float64),
         "skipped": skipped,
         "wall_time_s": walls,
     }
@@ -202,8 +204,11 @@ def calibrate_uq(
         "form": "sigma = sqrt((scale * sigma_raw)^2 + floor^2); the narrowest median interval covering coverage_target of these cases",
         "coverage_target": FIT_COVERAGE,
         "training": report,
+        "fit": fit_distribution(data["fit_nrmse"]),  # how well it explains its twin (`verdict.fit_limit`)
         "wall_time_s": round(time.perf_counter() - start, 1),
         "versions": versions(),
-        "data": {k: np.asarray(v).round(6).tolist() for k, v in data.items() if k not in ("wall_time_s", "skipped")},
+        "data": {
+            k: np.asarray(v).round(6).tolist() for k, v in data.items() if k not in ("wall_time_s", "skipped")
+        },
     }
     return Factors(fitted.scale, fitted.floor, record)

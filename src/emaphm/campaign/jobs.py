@@ -73,7 +73,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
         "wall_time_s": data["wall_time_s"], "reference": job["reference"],
         "second_search": json.dumps(second) if (second := stage_record(data["settings"].get("stages", []), "second_search") or {}).get("ran") else None,
         "reference_sha256": job["reference_sha256"], "settings": json.dumps(job["settings"], sort_keys=True),
-        "warnings": json.dumps(data["warnings"]), "worker": _worker(), "finished": _now(), "version": __version__,
+        "warnings": json.dumps(data["warnings"]), "doubts": json.dumps(data["doubts"]), "worker": _worker(), "finished": _now(), "version": __version__,
         "fingerprint": job.get("fingerprint") or None,
         "numba_threads": _pool(),
     }  # fmt: skip

@@ -45,6 +45,7 @@ RESULT_COLUMNS: dict[str, str] = {
     "second_search": "string", "reference": "string", "reference_sha256": "string", "settings": "string", "warnings": "string",
     "worker": "string", "numba_threads": "int64", "finished": "string", "version": "string",
     "fingerprint": "string",  # what computed the row (`fingerprint`); null in stores made before it
+    "doubts": "string",  # JSON: why the verdict is "doubtful" (none: []); null in stores made before it
 }  # fmt: skip
 FAILURE_COLUMNS: dict[str, str] = {
     "job_key": "string", "flight": "int64", "seed": "int64", "error": "string", "message": "string",

@@ -2,7 +2,8 @@
 
 Exit status: 0 success, 2 bad input or usage (one-line reason on stderr), 1 failure (one line
 too: a diverged simulation, a file system error), 3 `identify` ran but the monitor cannot explain
-the recording (verdict "does not fit", no faults reported), 130 interrupted (Ctrl-C). Every check of the
+the recording (verdict "does not fit", no faults reported), 4 `identify` ran and its diagnosis is
+doubtful (verdict "doubtful": faults reported, the reasons warned of), 130 interrupted (Ctrl-C). Every check of the
 input, output paths included, runs before the work, and no output is ever left half-written.
 
 Only light modules are imported at start (`emaphm --version` and `--help` answer at once); each

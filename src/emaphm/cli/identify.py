@@ -76,8 +76,9 @@ def identify(
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current.
 
-    Exit status 0 with a diagnosis, 2 for bad input (nothing run), 3 when the monitor cannot
-    explain the recording (verdict "does not fit": no faults are reported).
+    Exit status 0 with a diagnosis (verdict "fits"), 4 with a doubtful one (verdict "doubtful":
+    the faults are reported, each reason a warning), 3 when the monitor cannot explain the
+    recording (verdict "does not fit": no faults are reported), 2 for bad input (nothing run).
     """
     import json
 
@@ -117,8 +118,8 @@ def identify(
         typer.echo(json.dumps(data))
     else:
         print_identification(data)
-    if data["verdict"] != "fits":
-        raise typer.Exit(3)  # ran, but no diagnosis: scripts must not read it as one
+    if data["verdict"] != "fits":  # ran, but no diagnosis, or a doubtful one: a script must not take it for sure
+        raise typer.Exit(3 if data["verdict"] == "does not fit" else 4)
 
 
 # the settings' options (`IdentifySettings`, the one list of them) after the inputs, in its order

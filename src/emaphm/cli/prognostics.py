@@ -45,6 +45,13 @@ def rul(
             "Kalman filter (pip install 'emaphm[progpy]')."
         ),
     ] = "trend",
+    include_doubtful: Annotated[
+        bool,
+        typer.Option(
+            "--include-doubtful",
+            help='Track the diagnoses with verdict "doubtful" too (default: left out, and counted).',
+        ),
+    ] = False,
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write the prognosis figure here (.png).")] = None,
 ) -> None:
@@ -65,7 +72,8 @@ def rul(
         given.update(load_thresholds(params))
     given.update(parse_thresholds(threshold))
     report = rul_report(store, actuator, campaign=campaign, at_flight=at_flight, thresholds=given,
-                        inspection_interval=inspection_interval, estimator=estimator)  # fmt: skip
+                        inspection_interval=inspection_interval, estimator=estimator,
+                        include_doubtful=include_doubtful)  # fmt: skip
     data = {k: v for k, v in report.items() if not k.startswith("_")}
     if plot is not None:
         from ..plots import plot_rul

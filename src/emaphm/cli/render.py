@@ -33,9 +33,14 @@ def print_identification(data: dict[str, Any]) -> None:
     if data["percent_error"] is not None:
         out.print(f"%err {data['percent_error']:.2f}")
     if data["fit_nrmse"] is not None:
+        limit = data["settings"].get("doubtful_above") or {}
+        usual = (
+            f"doubtful above {100 * limit['nrmse']:.2f} % ({limit['source']})"
+            if limit
+            else "doubtful above 6 %"
+        )
         out.print(
-            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current (the twin's actuators: 0.3-3.9 %; "
-            "above 6 % a warning, above 50 %: does not fit)"
+            f"fit NRMSE {100 * data['fit_nrmse']:.2f} % of the filtered current ({usual}; above 50 %: does not fit)"
         )
     from ..identification.result import stage_record
 
@@ -45,9 +50,17 @@ def print_identification(data: dict[str, Any]) -> None:
     stage = (stage_record(data["settings"].get("stages", []), "last_stage") or {}).get("switching")
     if stage is not None:
         out.print(_switching_stage_line(stage))
-    if data["verdict"] != "fits":
+    if data["verdict"] == "does not fit":
         out.print("verdict: does not fit (see the warning): no faults reported")
     else:
+        if data["verdict"] == "doubtful":
+            reasons = len(data.get("doubts") or [])
+            out.print(
+                f"verdict: doubtful ({reasons} reason{'s' * (reasons != 1)}, in the warnings): the faults below "
+                "are what the monitor found, not a sure diagnosis"
+            )
+        else:
+            out.print("verdict: fits")
         out.print(f"detected: {', '.join(data['detected']) or 'none (healthy)'}")
         unsure = [n for n, v in verdicts.items() if v == "cannot tell"]
         if unsure:
@@ -78,7 +91,7 @@ def _second_search_line(second: dict[str, Any]) -> str:
     kept = "its result kept" if second["taken"] else "the first search's result kept"
     return (
         f"second search: the first fit's NRMSE {100 * second['first_fit_nrmse']:.2f} % was above the monitor's "
-        f"usual ({100 * second['trigger']:g} %); the second search's fitness "
+        f"usual ({100 * second['trigger']:.3g} %); the second search's fitness "
         f"{'not finite' if ratio is None else f'{ratio:.3f} x the first'}: {kept}"
     )
 
@@ -110,7 +123,9 @@ def print_inspection(info: dict[str, Any]) -> None:
         table = Table(title="mapped channels (min and max converted to SI)")
         for column in ("channel", "name", "file unit", "samples", "rate [Hz]", "duration [s]", "min", "max",
                        "equal samples at an extreme"):  # fmt: skip
-            table.add_column(column, justify="right" if column in ("samples", "rate [Hz]", "duration [s]") else "left")
+            table.add_column(
+                column, justify="right" if column in ("samples", "rate [Hz]", "duration [s]") else "left"
+            )
         for role, ch in info["channels"].items():
             si = f" {ch['si_unit']}" if ch.get("si_unit") else ""
             sat = ch.get("saturation")
@@ -232,6 +247,11 @@ def print_rul(data: dict[str, Any]) -> None:
         )  # fmt: skip
     out = stdout_console()
     out.print(table)
+    if data.get("doubtful_left_out"):
+        out.print(
+            f"{data['doubtful_left_out']} doubtful diagnos{'is' if data['doubtful_left_out'] == 1 else 'es'} left out "
+            '(verdict "doubtful"; --include-doubtful to track them)'
+        )
     first = data["first_failure"]
     if first["status"] == "tracked":
         out.print(

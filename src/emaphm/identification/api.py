@@ -18,7 +18,7 @@ from .._versions import versions
 from ..actuator import resolve_params
 from ..calibration import Calibration, params_hash
 from ..commands import Chirp
-from ..errors import InputError
+from ..errors import Doubt, InputError
 from ..models import MonitorEma
 from ..params import EmaParams
 from ..results import SimResult
@@ -27,11 +27,12 @@ from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
 from .optimizers import OnGeneration
+from .preconditions import motion_doubts
 from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult
 from .settings import IdentifySettings
 from .uncertainty import Factors, Uncertainty, load_factors
-from .verdict import explains, fit_warnings, judge, recording_warnings
+from .verdict import explains, fit_doubts, fit_limit, fit_warnings, judge, recording_warnings
 
 __all__ = ["identify"]
 
@@ -68,26 +69,46 @@ def identify(
     start = time.perf_counter()
     noise_seed, opt_seed = split_seed(s.seed)
     m = measurement(true_faults, reference, channel_map, actuator, noise_seed)
-    ident = FaultIdentifier(s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation)
+    doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
+    ident = FaultIdentifier(
+        s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation, doubtful_nrmse=doubtful[0]
+    )
     with numba_threads(s.workers):
         ident.fit(m.trace.t, m.trace.i_q, m.command, m.theta_u)
     warnings = [
         *(m.conversion or {}).get("warnings", []),
         *recording_warnings(
-            ident.context_, m.trace.t, m.trace.theta_cmd, monitor.calibration, thresholds, command_rate(m.conversion)
+            ident.context_,
+            m.trace.t,
+            m.trace.theta_cmd,
+            monitor.calibration,
+            thresholds,
+            command_rate(m.conversion),
         ),
     ]
     interval = None
     if factors is not None and explains(ident.fit_nrmse_):
         interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings)
     warnings += fit_warnings(ident.fit_nrmse_)
+    warnings += fit_doubts(ident.fit_nrmse_, *doubtful, ident.record("second_search"))
+    motion_warnings, motion = (
+        motion_doubts(ident.context_, ident.faults_, m.trace.t, m.theta_u)
+        if explains(ident.fit_nrmse_)
+        else ([], None)
+    )
+    warnings += motion_warnings
+    doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
+    doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
     detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds)
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
+    record["doubtful_above"] = {"nrmse": doubtful[0], "source": doubtful[1]}  # `verdict.fit_limit`
+    record["motion"] = motion  # `preconditions.motion_doubts`
     return IdentificationResult(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=ident.run_.evaluations,
         wall_time_s=round(time.perf_counter() - start, 3), seed=s.seed, optimizer=s.optimizer, truth=m.truth,
         detected=detected, history=ident.run_.history, settings=record, warnings=warnings,
         fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged, curves=ident.curves(),
+        doubts=doubts,
     )  # fmt: skip
 
 
@@ -112,6 +133,26 @@ def _factors(method: str, given: Factors | str | os.PathLike[str] | None, last_s
     if method == "none":
         return None
     return given if isinstance(given, Factors) else load_factors(given, last_stage=last_stage)
+
+
+def _fit_record(
+    s: IdentifySettings, factors: Factors | None, given: Any, monitor: MonitorEma
+) -> dict[str, Any] | None:
+    """The interval calibration's record that measured how well this monitor explains its twin
+    (`verdict.fit_limit`): the one in use, else (no intervals asked for) the one that would be; None
+    when it belongs to another LF calibration."""
+    if factors is None and not isinstance(given, Factors):
+        try:
+            factors = load_factors(
+                given, last_stage=resolve_last_stage(s.last_stage, monitor.monitor, polish=s.polish)
+            )
+        except InputError:
+            return None
+    if isinstance(given, Factors) and factors is None:
+        factors = given
+    if factors is None or not factors.record or not factors.matches(monitor.calibration):
+        return None
+    return factors.record
 
 
 def _intervals(

@@ -39,7 +39,9 @@ class Context:
     measurement on the model grid over it; whole : the same over the whole recording when longer
     (None: the same); mask : the samples compared (0/1); compared, above_band : the fractions of
     the recording compared and left out as faster than `weights.BAND_HZ`; error_corner_hz : the
-    corner of the frequency weights (None: none); objective : eq. 3 over the compared samples.
+    corner of the frequency weights (None: none); objective : eq. 3 over the compared samples;
+    doubtful_nrmse : the fit above which the result is doubtful (`verdict.fit_limit`), which also
+    starts the second search when below its trigger.
     """
 
     settings: IdentifySettings
@@ -54,6 +56,8 @@ class Context:
     error_corner_hz: float | None
     objective: Fitness
     on_generation: OnGeneration | None = None
+    # the NRMSE above which a fit is doubtful for this monitor (`verdict.fit_limit`; None: not known)
+    doubtful_nrmse: float | None = None
 
     def with_seed(self, seed: int) -> Context:
         """The same comparison searched from another optimiser seed (`second_search`)."""
@@ -145,6 +149,7 @@ def prepare(
     settings: IdentifySettings,
     monitor: MonitorEma | None = None,
     on_generation: OnGeneration | None = None,
+    doubtful_nrmse: float | None = None,
 ) -> Context:
     """Check the measurement i_q [A] at t [s] (under `command`, default the monitor's; `theta_u`
     [rad], the surface position if measured, tells the rests in holds) and set up the comparison."""
@@ -189,5 +194,5 @@ def prepare(
     reference = whole if shown is None else Comparison.from_trace(t - t[0], i_q, grid, f_s)
     return Context(
         settings, settings.seed, model, duration, reference, shown, mask, compared, float(1.0 - in_band.mean()),
-        corner, Fitness(reference, settings.slope_unit, mask, emphasis), on_generation,
+        corner, Fitness(reference, settings.slope_unit, mask, emphasis), on_generation, doubtful_nrmse,
     )  # fmt: skip

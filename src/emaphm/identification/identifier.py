@@ -50,6 +50,9 @@ class FaultIdentifier:
         the settings' ``monitor``, for the packaged calibration (None: the settings').
     on_generation : callable(gen, max_gen, best), optional
         Progress callback.
+    doubtful_nrmse : float, optional
+        The fit [-] above which the result is doubtful (`verdict.fit_limit`); the second search
+        starts from it where it is below the monitor's trigger (`limits.SECOND_SEARCH_NRMSE`).
 
     After `prepare`: ``context_`` (`context.Context`) and, from it, ``monitor_``, ``duration_``
     [s], ``reference_``, ``whole_``, ``mask_``, ``compared_``, ``above_band_``,
@@ -67,6 +70,7 @@ class FaultIdentifier:
         *,
         monitor: MonitorEma | str | None = None,
         on_generation: OnGeneration | None = None,
+        doubtful_nrmse: float | None = None,
         **options: Any,
     ) -> None:
         if isinstance(monitor, str):  # the monitor by name: the settings' field (docs/conventions.md)
@@ -78,6 +82,7 @@ class FaultIdentifier:
             )
         self.monitor = monitor
         self.on_generation = on_generation
+        self.doubtful_nrmse = doubtful_nrmse
 
     def prepare(
         self, t: ArrayLike, i_q: ArrayLike, command: Command | None = None, theta_u: ArrayLike | None = None
@@ -86,7 +91,7 @@ class FaultIdentifier:
         it first); `theta_u` [rad], the measured surface position at t if the trace has it,
         tells where the surface rests in a hold (`weights.moving_mask`)."""
         ctx = prepare(t, i_q, command, theta_u, settings=self.settings, monitor=self.monitor,
-                      on_generation=self.on_generation)  # fmt: skip
+                      on_generation=self.on_generation, doubtful_nrmse=self.doubtful_nrmse)  # fmt: skip
         self.context_: Context = ctx
         self.monitor_, self.duration_, self.reference_, self.whole_ = (
             ctx.monitor,

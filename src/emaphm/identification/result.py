@@ -20,7 +20,7 @@ from ..faults import FAULT_NAMES
 from .metrics import absolute_errors, percent_error
 from .state import stage_record
 from .uncertainty import Uncertainty
-from .verdict import explains
+from .verdict import explains, verdict_of
 
 __all__ = ["IdentificationResult", "stage_record"]
 
@@ -40,10 +40,11 @@ class IdentificationResult:
     history : list of float  the search's best eq. (3) per generation [A²]
     settings : dict  the record: settings, limits, stage records, inputs and versions (`stage`)
     version : str  emaphm's version
-    warnings : list of str  what makes the result doubtful, one sentence each
+    warnings : list of str  what the result warns of, one sentence each
     fit_nrmse : float or None  NRMSE of the fitted current against the measured one [-]
     uncertainty : Uncertainty or None  the 90 % intervals (None with ``uncertainty="none"``)
     fault_verdicts : dict or None  "present", "absent" or "cannot tell" per detectable fault
+    doubts : list of str  why the verdict is "doubtful" (a subset of `warnings`; empty: it is not)
     curves : dict of ndarray or None  t, measured, fitted, compared on the model grid (not in the JSON)
     """
 
@@ -64,19 +65,22 @@ class IdentificationResult:
     uncertainty: Uncertainty | None = None
     # per detectable fault: "present", "absent" or "cannot tell" (`uncertainty.verdicts`)
     fault_verdicts: dict[str, str] | None = None
+    # why the result is doubtful, one sentence per reason (each also in `warnings`; `verdict`)
+    doubts: list[str] = field(default_factory=list)
     # the fit on the model grid (`FaultIdentifier.curves`), for figures and reports; not in the JSON
     curves: dict[str, NDArray[np.float64]] | None = field(default=None, repr=False, compare=False)
 
     @property
     def fits(self) -> bool:
-        """True when the monitor explains the measurement (`FIT_NRMSE_LIMIT`); else no faults are
-        reported: a result the model cannot explain is not a diagnosis."""
+        """True when the monitor explains the measurement (`FIT_NRMSE_LIMIT`; the verdict "fits"
+        or "doubtful"); else no faults are reported: a result the model cannot explain is not a diagnosis."""
         return explains(self.fit_nrmse)
 
     @property
     def verdict(self) -> str:
-        """ "fits" or "does not fit" (see `fits`)."""
-        return "fits" if self.fits else "does not fit"
+        """ "fits", "doubtful" (faults reported; the reasons in `doubts`) or "does not fit" (none
+        reported; `verdict.verdict_of`)."""
+        return verdict_of(self.fit_nrmse, self.doubts)
 
     def stage(self, name: str) -> dict[str, Any] | None:
         """The record of the stage `name` ("search", "polish", "final_checks", "least_squares",
@@ -99,6 +103,7 @@ class IdentificationResult:
             "absolute_errors": None if truth is None else absolute_errors(self.estimate, truth).tolist(),
             "detected": self.detected,
             "verdict": self.verdict,
+            "doubts": list(map(str, self.doubts)),
             "fit_nrmse": None
             if self.fit_nrmse is None or not np.isfinite(self.fit_nrmse)
             else self.fit_nrmse,

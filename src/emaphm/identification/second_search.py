@@ -1,7 +1,7 @@
 """Stage 4: a second, independent search when the first one's fit is poorer than the monitor's usual.
 
 It runs when the fit's NRMSE over the compared samples exceeds `limits.SECOND_SEARCH_NRMSE` of the
-monitor while the fit still explains the measurement (`limits.FIT_NRMSE_LIMIT`), with the
+monitor, or the actuator's doubtful limit when lower (`verdict.fit_limit`, `Context.doubtful_nrmse`), while the fit still explains the measurement (`limits.FIT_NRMSE_LIMIT`), with the
 settings' ``polish`` and ``second_search``; it searches from `second_seed` and the lower eq. 3
 fitness (the search's own measure) is kept. The kept state counts both searches' evaluations;
 its history is the kept search's.
@@ -32,6 +32,8 @@ def second_search(state: State | None, context: Context) -> tuple[State, Record]
     trigger = (
         limits.SECOND_SEARCH_NRMSE.get(context.monitor.monitor) if s.polish and s.second_search else None
     )
+    if trigger is not None and context.doubtful_nrmse is not None:  # a fit that would be doubtful
+        trigger = min(trigger, context.doubtful_nrmse)
     record: Record = {"stage": "second_search", "enabled": bool(s.polish and s.second_search), "ran": False}
     if trigger is None or not trigger < state.fit_nrmse <= limits.FIT_NRMSE_LIMIT:
         return state, record

@@ -1,8 +1,13 @@
 """Stage 7: the verdict. Does the fit explain the recording, what does the result warn of, and which
 faults are present.
 
-A fit whose NRMSE exceeds `limits.FIT_NRMSE_LIMIT` is not a diagnosis ("does not fit": no faults
-are reported); above `limits.FIT_NRMSE_WARN` it is reported with a warning. Faults are detected
+Three verdicts (`verdict_of`). A fit whose NRMSE exceeds `limits.FIT_NRMSE_LIMIT` is not a
+diagnosis ("does not fit": no faults are reported). A result is "doubtful" (its faults reported,
+each reason a warning, `errors.Doubt`) when the recording is explained less well than this
+actuator's monitor explains its own twin (`fit_limit`: from the interval calibration's measured
+fits), when the search needed its second start, or when a precondition of the diagnosis is not met
+(the recording starts in motion, a command the monitor was not calibrated on, little data
+compared, a given angle offset the currents contradict). Otherwise it "fits". Faults are detected
 by their 90 % intervals against the detection thresholds (`uncertainty.verdicts`), or by the
 point rule without intervals (`detection.detect`).
 """
@@ -13,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import Doubt
 from . import limits
 from .detection import detect, load_thresholds
 
@@ -21,7 +27,39 @@ if TYPE_CHECKING:
     from .context import Context
     from .uncertainty import Uncertainty
 
-__all__ = ["explains", "fit_warnings", "judge", "recording_warnings"]
+__all__ = [
+    "explains", "fit_distribution", "fit_doubts", "fit_limit", "fit_warnings", "judge", "recording_warnings",
+    "verdict_of",
+]  # fmt: skip
+
+
+def fit_distribution(fits: Any) -> dict[str, Any]:
+    """How well a monitor explains its own twin, from the fits' NRMSE of identified twin cases
+    (`calibration.fit_intervals`): their count, median, p90, p99, max and the NRMSE above which a
+    fit is doubtful (`limits.DOUBTFUL_MARGIN` x the `limits.DOUBTFUL_QUANTILE`)."""
+    values = np.asarray(fits, dtype=np.float64)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return {"cases": 0}
+    q = {name: float(np.quantile(values, p)) for name, p in (("median", 0.5), ("p90", 0.9), ("p99", 0.99))}
+    return {
+        "cases": int(values.size), **{k: round(v, 6) for k, v in q.items()}, "max": round(float(values.max()), 6),
+        "doubtful_above": round(limits.DOUBTFUL_MARGIN * float(np.quantile(values, limits.DOUBTFUL_QUANTILE)), 6),
+    }  # fmt: skip
+
+
+def fit_limit(record: dict[str, Any] | None, monitor: str) -> tuple[float, str]:
+    """The NRMSE above which a fit is "doubtful", and where it comes from: the interval
+    calibration's measured fits (its record's ``data["fit_nrmse"]``, `fit_distribution`), else the
+    monitor's second-search trigger (`limits.SECOND_SEARCH_NRMSE`)."""
+    fits = ((record or {}).get("data") or {}).get("fit_nrmse")
+    if fits:
+        measured = fit_distribution(fits)
+        if measured["cases"] >= 20:
+            return measured["doubtful_above"], f"the interval calibration's {measured['cases']} twin cases"
+    return limits.SECOND_SEARCH_NRMSE.get(
+        monitor, limits.FIT_NRMSE_WARN
+    ), "no twin fits measured; the monitor's default"
 
 
 def explains(fit_nrmse: float | None) -> bool:
@@ -41,7 +79,8 @@ def recording_warnings(
     on, motion above the band, little data compared, thresholds measured with another monitor."""
     from .coverage import command_warnings
 
-    warnings = command_warnings(t, theta_cmd, calibration, command_rate)
+    # a command the monitor was not calibrated on is a precondition not met
+    warnings: list[str] = [Doubt(w) for w in command_warnings(t, theta_cmd, calibration, command_rate)]
     if context.above_band > 0:
         warnings.append(
             f"{100 * context.above_band:.0f} % of the recording commands motion faster than the "
@@ -49,9 +88,11 @@ def recording_warnings(
         )
     if context.compared < limits.MIN_COMPARED:
         warnings.append(
-            f"only {100 * context.compared:.0f} % of the recording is compared: the rest is a hold where the surface "
-            "rests, whose current does not depend on the faults, or motion faster than the monitor was fitted on; "
-            "the diagnosis rests on little data"
+            Doubt(
+                f"only {100 * context.compared:.0f} % of the recording is compared: the rest is a hold where the surface "
+                "rests, whose current does not depend on the faults, or motion faster than the monitor was fitted on; "
+                "the diagnosis rests on little data"
+            )
         )
     if thresholds is None:
         from ..calibration.files import params_hash
@@ -77,20 +118,49 @@ def recording_warnings(
 
 
 def fit_warnings(fit_nrmse: float) -> list[str]:
-    """A poor fit's warning, or a fit that does not explain the recording's."""
+    """The warning of a fit that does not explain the recording (a poor one's is `fit_doubts`')."""
     if not explains(fit_nrmse):
         return [
             f"the monitor cannot explain this recording (NRMSE {100 * fit_nrmse:.3g} % of the "
             f"filtered current, at most {100 * limits.FIT_NRMSE_LIMIT:g} % for a diagnosis): check the units, "
             "signs and command of the trace; no faults are reported"
         ]
-    if fit_nrmse > limits.FIT_NRMSE_WARN:
-        return [
-            f"the fit is poor (NRMSE {100 * fit_nrmse:.3g} % of the filtered current; the twin's actuators "
-            f"fit to 0.3-3.9 %): the faults below are doubtful; check the current's gain and the recording's segment, "
-            "command and actuator"
-        ]
     return []
+
+
+def fit_doubts(fit_nrmse: float, limit: float, source: str, second: dict[str, Any] | None) -> list[str]:
+    """The fit's reasons for "doubtful": an NRMSE above this actuator's `limit` (`fit_limit`, from
+    `source`; at most `limits.FIT_NRMSE_WARN`), a search that needed its second start
+    (`second_search`'s record)."""
+    if not explains(fit_nrmse):
+        return []  # "does not fit" says it (`fit_warnings`)
+    doubts: list[str] = []
+    if limit > limits.FIT_NRMSE_WARN:
+        limit, source = limits.FIT_NRMSE_WARN, "the cap on every actuator's limit"
+    if np.isfinite(fit_nrmse) and fit_nrmse > limit:
+        doubts.append(
+            Doubt(
+                f"the recording is explained less well than this actuator's monitor explains its own twin: "
+                f"NRMSE {100 * fit_nrmse:.2f} % against at most {100 * limit:.2f} % ({source}); the faults "
+                "are doubtful: check the current's gain, the segment, the command and the actuator file"
+            )
+        )
+    if second is not None and second.get("ran"):
+        doubts.append(
+            Doubt(
+                f"the search needed its second start (its first fit {100 * second['first_fit_nrmse']:.2f} % "
+                f"was above {100 * second['trigger']:.2f} %): more than one set of faults nearly explains this "
+                "recording, or none does well"
+            )
+        )
+    return doubts
+
+
+def verdict_of(fit_nrmse: float | None, doubts: list[str]) -> str:
+    """ "does not fit" (`explains`), "doubtful" (any reason in `doubts`) or "fits"."""
+    if not explains(fit_nrmse):
+        return "does not fit"
+    return "doubtful" if doubts else "fits"
 
 
 def judge(

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
-from ..errors import InputError
+from ..errors import Doubt, InputError
 from ..identification.signals import lowpass
 from ..kernels.transforms import clarke, park
 from ..params import EmaParams
@@ -138,6 +138,7 @@ def _questioned(given: float, estimated: float, params: EmaParams, report: dict[
     """A warning when the map's offset and the one the currents show differ by more than
     `OFFSET_DISAGREE_DEG` (mod 180°: i_d² cannot tell the two), with the likely slip: mechanical
     degrees written for electrical ones (the given value × p matches), or a wrong offset."""
+
     def apart(a: float, b: float) -> float:
         return abs((math.degrees(a - b) + 90.0) % 180.0 - 90.0)
 
@@ -151,9 +152,11 @@ def _questioned(given: float, estimated: float, params: EmaParams, report: dict[
         else 'check it, or let emaphm estimate it (offset = "estimate")'
     )
     return [
-        f"the channel map's angle offset {math.degrees(given):.1f} deg (electrical) differs by "
-        f"{apart(given, estimated):.1f} deg from the one the currents show ({math.degrees(estimated) % 180:.1f} deg, "
-        f"mod 180): {hint}; the given one is used"
+        Doubt(
+            f"the channel map's angle offset {math.degrees(given):.1f} deg (electrical) differs by "
+            f"{apart(given, estimated):.1f} deg from the one the currents show ({math.degrees(estimated) % 180:.1f} deg, "
+            f"mod 180): {hint}; the given one is used"
+        )
     ]
 
 
@@ -223,12 +226,16 @@ def phases_to_iq(
         theta0, i_q, correlation, flipped = (theta0 + math.pi) % (2 * math.pi), -i_q, -correlation, True
     elif offset is not None and correlation < 0:
         warnings.append(
-            f"with the given angle.offset, i_q opposes the torque the motion needs (correlation {correlation:.2f}): "
-            "is the offset 180 deg off?"
+            Doubt(
+                f"with the given angle.offset, i_q opposes the torque the motion needs (correlation {correlation:.2f}): "
+                "is the offset 180 deg off?"
+            )
         )
     if abs(correlation) < _WEAK_CORRELATION:
         warnings.append(
-            f"the sign of i_q is uncertain: its correlation with the torque the motion needs is {correlation:.2f}"
+            Doubt(
+                f"the sign of i_q is uncertain: its correlation with the torque the motion needs is {correlation:.2f}"
+            )
         )
     report.update(offset_deg=math.degrees(theta0), pi_added=flipped, torque_correlation=correlation)
     return Alignment(i_q, (i_a, i_b, i_c), theta_e + theta0, theta0, report, warnings)

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .._version import __version__
-from ..errors import InputError
+from ..errors import Doubt, InputError
 from ..params import EmaParams
 from ..results import SimResult
 from . import limits
@@ -62,7 +62,9 @@ class Reference:
 
 
 def to_reference(
-    measurement: Measurement, params: EmaParams | str | os.PathLike[str] | None = None, f_s: float | None = None
+    measurement: Measurement,
+    params: EmaParams | str | os.PathLike[str] | None = None,
+    f_s: float | None = None,
 ) -> Reference:
     """Turn `measurement` into a reference trace on the model grid (see the module docstring).
 
@@ -104,11 +106,7 @@ def to_reference(
     except InputError as exc:
         raise InputError(f"{src}: {exc}") from None
     if not starts_at_rest(m["theta_cmd"], seg.start):
-        warnings.append(
-            f"the recording starts in motion: the position command moves in its first "
-            f"{1000 * limits.REST_WINDOW_S:g} ms (from {seg.start:.4g} s in the file), but the monitor starts at rest; "
-            "start the logger before the command, or the diagnosis may be off"
-        )
+        warnings.append(_in_motion(seg.start))
     runs = {ch.role: cut_run(ch, seg.runs[ch.role], seg.start, seg.end) for ch in channels}
     theta_e_run, angle_info = _angle(m, runs, params)  # 4. angle ratio
 
@@ -125,6 +123,8 @@ def to_reference(
     if cut:
         warnings.append(_cut_warning(report["segments"], f_s))
     report["warnings"] = warnings
+    # the preconditions not met, as plain strings so that a converted trace's file keeps them
+    report["doubts"] = [str(w) for w in warnings if isinstance(w, Doubt)]
     metadata = {
         "model": "measured",
         "source": str(src),
@@ -140,6 +140,15 @@ def to_reference(
     if problems:
         raise InputError(f"{src}: after conversion: {problems[0]}")
     return Reference(trace, report)
+
+
+def _in_motion(start: float) -> Doubt:
+    """The precondition a recording that starts in motion breaks (`timebase.starts_at_rest`)."""
+    return Doubt(
+        f"the recording starts in motion: the position command moves in its first {1000 * limits.REST_WINDOW_S:g} ms "
+        f"(from {start:.4g} s in the file), but the monitor starts at rest; start the logger before the command, "
+        "or the diagnosis may be off"
+    )
 
 
 def _dropouts_as_gaps(channels: list[Channel], command: Channel, warnings: list[str]) -> list[Channel]:

@@ -4,7 +4,8 @@ For one actuator of a results store (`emaphm.campaign`), each fault is tracked f
 detection (verdict "present"): its later identifications, each with its standard deviation
 (the calibrated 90 % interval's), enter a `DegradationTrend` with the fault's law; a measurement
 the identification could not size (flag ``non_identifiable``, no interval, or a verdict "does not
-fit") carries no information and is left out. The trend's crossing of the fault's failure
+fit") carries no information and is left out. Diagnoses with verdict "doubtful" are left out too
+(and counted, ``doubtful_left_out``) unless asked for (``include_doubtful``). The trend's crossing of the fault's failure
 threshold gives the RUL in flights, per fault and for the first failure.
 
 Failure thresholds, as distances from healthy in fault units: given (``--threshold``, or the
@@ -32,6 +33,7 @@ __all__ = ["ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "parse_t
 SAMPLES = 4000
 _NO_RUL = {"rul_median": None, "rul_p05": None, "rul_p95": None}
 ESTIMATORS = ("trend", "ukf")
+USED_VERDICTS = ("fits", "doubtful")  # of the rows kept (`rul_report`'s include_doubtful)
 
 
 def history(
@@ -61,7 +63,7 @@ def _measurement(row: dict[str, Any], name: str) -> tuple[float, float] | None:
     """(value, sd) of a fault in one row, or None where the row tells nothing about it."""
     column = FAULTS[name][0]
     j = int(column[1:]) - 1
-    if row.get("verdict") != "fits":
+    if row.get("verdict") not in USED_VERDICTS:  # "does not fit" sizes nothing; doubtful ones chosen before
         return None
     flags = json.loads(row["uq_flags"]) if row.get("uq_flags") else None
     if flags is not None and "non_identifiable" in flags[j]:
@@ -122,6 +124,7 @@ def rul_report(
     inspection_interval: float = 10.0,
     seed: int = 0,
     estimator: str = "trend",
+    include_doubtful: bool = False,
 ) -> dict[str, Any]:
     """The RUL of each tracked fault and of the first failure, as of flight `at_flight` (default:
     the last one stored), JSON-ready; see the module docstring. `estimator`: "trend"
@@ -147,6 +150,9 @@ def rul_report(
         Seed of the draws of the first failure's distribution.
     estimator : {"trend", "ukf"}
         The tracker (above).
+    include_doubtful : bool
+        Use the diagnoses with verdict "doubtful" too (default: left out, and counted in
+        ``doubtful_left_out``): their faults are what the monitor found, not a sure diagnosis.
     """
     if estimator not in ESTIMATORS:
         raise InputError(f"unknown estimator {estimator!r}; use one of {', '.join(ESTIMATORS)}")
@@ -158,6 +164,7 @@ def rul_report(
         if not rows:
             raise InputError(f"actuator {actuator!r} has no flight at or before {at_flight}")
     t_now = float(at_flight if at_flight is not None else rows[-1]["flight"])
+    rows, left_out = (rows, 0) if include_doubtful else _sure(rows, actuator)
     faults, tracked = _tracked(rows, dict(thresholds or {}))
     trends: dict[str, Any] = {}
     estimates: dict[str, RulEstimate] = {}
@@ -184,8 +191,20 @@ def rul_report(
     return {
         "actuator": actuator, "campaign": rows[0]["campaign"], "at_flight": t_now, "estimator": estimator,
         "flights_stored": len({r["flight"] for r in rows}), "inspection_interval": inspection_interval,
+        "include_doubtful": include_doubtful, "doubtful_left_out": left_out,
         "faults": faults, "first_failure": first, "_trends": trends, "_estimates": estimates,
     }  # fmt: skip
+
+
+def _sure(rows: list[dict[str, Any]], actuator: str) -> tuple[list[dict[str, Any]], int]:
+    """The rows whose verdict is not "doubtful" and how many were; `InputError` when none is left."""
+    doubtful = sum(r.get("verdict") == "doubtful" for r in rows)
+    if doubtful == len(rows):
+        raise InputError(
+            f"all {doubtful} diagnoses of actuator {actuator!r} are doubtful (verdict \"doubtful\"): pass "
+            "--include-doubtful to track them anyway"
+        )
+    return [r for r in rows if r.get("verdict") != "doubtful"], doubtful
 
 
 def _tracked(
