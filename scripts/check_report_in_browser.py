@@ -4,9 +4,12 @@
 
 Loads REPORT_DIR/index.html in headless Chromium (Debian's `chromium` package; `apt install
 chromium`), after its scripts ran, and checks that every figure decoded (the page's own count
-of images with a natural width, `data-images-loaded`), that the verdict and the per-fault table
-are in the rendered page, and that the page asked for nothing outside itself. Prints what it
-found; exit 0 when all hold, 1 otherwise, 2 when no browser is installed.
+of images with a natural width, `data-images-loaded`), that the verdict is in the rendered page
+with its word, that a page that fits (or is doubtful) shows the per-fault table and the faults
+figure while one that does not fit shows neither (no fault values, no fault bars) but says that no
+faults are reported, that the result's JSON is there as a download, and that the page asked for
+nothing outside itself. Prints what it found; exit 0 when all hold, 1 otherwise, 2 when no
+browser is installed.
 """
 
 from __future__ import annotations
@@ -55,10 +58,7 @@ def check(report: Path, screenshot: Path | None = None) -> list[str]:
         problems.append("the page's script did not run (no data-images-loaded)")
     elif loaded.group(1) != loaded.group(2) or loaded.group(2) == "0":
         problems.append(f"figures decoded: {loaded.group(1)} of {loaded.group(2)}")
-    if not re.search(r'class="verdict (fits|doubt|nofit)"', dom):
-        problems.append("no verdict in the rendered page")
-    if "k1 friction" not in dom or "k8 kp_drift" not in dom:
-        problems.append("the per-fault table is not in the rendered page")
+    problems += _content_problems(dom)
     outside = re.findall(r'(?:src|href)="(?!data:)([^"]+)"', source)
     if outside:
         problems.append(f"the page refers to files or addresses outside itself: {outside[:3]}")
@@ -69,6 +69,32 @@ def check(report: Path, screenshot: Path | None = None) -> list[str]:
                  page.resolve().as_uri()],
                 capture_output=True, timeout=120, check=False,
             )  # fmt: skip
+    return problems
+
+
+WORDS = {"fits": "fits", "doubt": "doubtful", "nofit": "does not fit"}
+
+
+def _content_problems(dom: str) -> list[str]:
+    """What the rendered page lacks, or shows though it must not, for its verdict."""
+    verdict = re.search(r'class="verdict (fits|doubt|nofit)"><p class="word">([^<]*)</p>', dom)
+    if verdict is None:
+        return ["no verdict in the rendered page"]
+    problems = []
+    kind, word = verdict.groups()
+    if word != WORDS[kind]:
+        problems.append(f"the verdict block {kind!r} says {word!r}")
+    table = "k1 friction" in dom and "k8 kp_drift" in dom
+    bars = "distance from healthy" in " ".join(re.findall(r'<img alt="([^"]*)"', dom))
+    if kind == "nofit":
+        if table or bars:
+            problems.append("a page that does not fit shows fault values or fault bars")
+        if "no faults are reported" not in dom:
+            problems.append("a page that does not fit does not say that no faults are reported")
+    elif not (table and bars):
+        problems.append("the per-fault table or the faults figure is not in the rendered page")
+    if not re.search(r'<a id="result-json" download="result.json" href="data:application/json;base64,', dom):
+        problems.append("no result.json download in the rendered page")
     return problems
 
 

@@ -19,6 +19,7 @@ from .results import SimResult
 __all__ = [
     "plot_calibration",
     "plot_convergence",
+    "plot_faults",
     "plot_fit",
     "plot_fit_curves",
     "plot_response",
@@ -97,18 +98,20 @@ def plot_fit_curves(
     title: str = "",
     raw: np.ndarray | None = None,
     model: str = "LF model",
+    fitted: str = "at the identified faults",
 ) -> Path:
     """An identification's fit (`FaultIdentifier.curves`): the filtered measured current, the
     `model`'s current at the estimate (the LF model's, or the switching model's after the last
-    stage) and their residual; samples the fitness left out (a rest in a hold, motion faster than
-    the monitor was fitted on) shaded, and the unfiltered measurement `raw` behind when given."""
+    stage; `fitted` says what the estimate is) and their residual; samples the fitness left out (a
+    rest in a hold, motion faster than the monitor was fitted on) shaded, and the unfiltered
+    measurement `raw` behind when given."""
     t, m, f = curves["t"], curves["measured"], curves["fitted"]
     fig = _figure((9, 6))
     ax = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
     if raw is not None:
         ax[0].plot(t, raw, color="0.8", lw=0.5, label="measured $i_q$ (raw)")
     ax[0].plot(t, m, "k", lw=1.0, label="measured $i_q$, filtered")
-    ax[0].plot(t, f, "C1", lw=1.0, label=f"{model} at the identified faults")
+    ax[0].plot(t, f, "C1", lw=1.0, label=f"{model} {fitted}")
     ax[0].set_ylabel("current [A]")
     ax[0].legend(loc="upper right", fontsize=8)
     ax[1].plot(t, m - f, "C3", lw=0.8)
@@ -126,7 +129,7 @@ def plot_fit_curves(
     return path
 
 
-def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
+def plot_convergence(histories: Mapping[str, list[float]], path: Path, title: str = "") -> Path:
     """Best fitness per generation of each run (log scale)."""
     fig = _figure((7, 4))
     ax = fig.subplots()
@@ -136,6 +139,63 @@ def plot_convergence(histories: Mapping[str, list[float]], path: Path) -> Path:
     ax.set_ylabel("best fitness, eq. (3) [A²]")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def plot_faults(
+    distance: Mapping[str, float],
+    path: Path,
+    *,
+    intervals: Mapping[str, tuple[float, float]] | None = None,
+    truth: Mapping[str, float] | None = None,
+    thresholds: Mapping[str, Mapping[str, float] | None] | None = None,
+    labels: Mapping[str, str] | None = None,
+    verdicts: Mapping[str, str] | None = None,
+    signed: Collection[str] = (),
+    note: str = "",
+    title: str = "",
+) -> Path:
+    """A diagnosis's faults as distances from healthy (fault units), one bar per fault of `distance`
+    (name → k − healthy) coloured by its verdict, with its 90 % interval (name → (low, high) as
+    distances) as a whisker, the true distance as a black diamond, each of `thresholds` (its label,
+    e.g. "detection threshold" → name → distance; the first dashed black, the next solid purple) as a
+    tick across the bar (at ± for the faults in `signed`), `labels` under the bars and `note` (the
+    eccentricity's direction, which is not a distance) as text."""
+    from matplotlib.patches import Patch
+
+    fig = _figure((9, 4.8))
+    ax = fig.subplots()
+    names = list(distance)
+    x = np.arange(len(names))
+    y = np.array([distance[n] for n in names])
+    colours = {"present": "C3", "cannot tell": "C1", "absent": "0.65"}
+    shown = {(verdicts or {}).get(n) for n in names}
+    ax.bar(x, y, 0.6, color=[colours.get((verdicts or {}).get(n, ""), "C0") for n in names])
+    handles = [Patch(color=c, label=v) for v, c in colours.items() if v in shown]
+    if intervals:
+        lo, hi = (np.array([intervals[n][j] for n in names]) for j in (0, 1))
+        handles.append(ax.errorbar(x, y, yerr=np.vstack([np.clip(y - lo, 0, None), np.clip(hi - y, 0, None)]),
+                                   fmt="none", ecolor="0.2", elinewidth=0.8, capsize=2, label="90 % interval"))  # fmt: skip
+    if truth is not None:
+        handles += ax.plot(x, [truth[n] for n in names], "kD", ms=4, label="true")
+    for (label, limits), style in zip((thresholds or {}).items(), (("k", "--"), ("C4", "-")), strict=False):
+        at = [(j, s * limits[n]) for j, n in enumerate(names) if limits and n in limits for s in (1, -1)
+              if s > 0 or n in signed]  # fmt: skip
+        if at:
+            j, v = np.array(at).T
+            handles.append(ax.hlines(v, j - 0.4, j + 0.4, colors=style[0], linestyles=style[1], lw=1.6,
+                                     zorder=3, label=label))  # fmt: skip
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xticks(x, [(labels or {}).get(n, n) for n in names], fontsize=7)
+    ax.set_xlabel(note, fontsize=8)
+    ax.set_ylabel("distance from healthy [fault units]")
+    ax.legend(handles=handles, fontsize=7, ncols=3, loc="upper right")
+    ax.grid(alpha=0.3, axis="y")
+    if title:
+        ax.set_title(title, fontsize=10)
     fig.savefig(path, dpi=110)
     return path
 

@@ -59,6 +59,13 @@ ReportOption = Annotated[
     Path | None,
     typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
 ]
+ActuatorIdOption = Annotated[
+    str | None,
+    typer.Option(
+        "--actuator-id",
+        help="The actuator's id (serial, position), recorded in the result and shown in the report.",
+    ),
+]
 
 
 def identify(
@@ -72,6 +79,7 @@ def identify(
     detection: DetectionOption = None,
     params: ParamsNeedCalibrationOption = None,
     report: ReportOption = None,
+    actuator_id: ActuatorIdOption = None,
     **options: Any,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current.
@@ -91,10 +99,11 @@ def identify(
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
         detection=detection,
     )  # fmt: skip
+    failure = _failure_thresholds(params) if report is not None else None  # a bad table: refused now
     with progress() as update:
         result = run_identify(
             truth, reference, settings=settings, calibration=calibration, uq_calibration=uq_calibration,
-            params=params, channel_map=map_file, thresholds=thresholds,
+            params=params, channel_map=map_file, thresholds=thresholds, actuator_id=actuator_id,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{settings.optimizer.upper()} generations", abs(gen), total
             ),
@@ -106,13 +115,15 @@ def identify(
         with atomic_path(output) as tmp:
             tmp.write_text(json.dumps(data, indent=2) + "\n")
     if report is not None:
+        from ..actuator import resolve_params
         from ..report import input_provenance, write_report
 
         provenance = input_provenance(
             reference, truth=truth, channel_map=map_file, conversion=data["settings"].get("conversion"),
-            params=params, calibration=calibration,
+            params=params, calibration=calibration, detection=detection,
         )  # fmt: skip
-        page = write_report(result, report, provenance=provenance)
+        page = write_report(result, report, provenance=provenance, params=resolve_params(params),
+                            thresholds=thresholds, failure_thresholds=failure)  # fmt: skip
         err.print(f"wrote the report {page}")
     if json_out:
         typer.echo(json.dumps(data))
@@ -124,6 +135,15 @@ def identify(
 
 # the settings' options (`IdentifySettings`, the one list of them) after the inputs, in its order
 with_settings_options(identify)
+
+
+def _failure_thresholds(params: Path | None) -> dict[str, float] | None:
+    """The failure thresholds of the actuator file's ``[thresholds]`` table (None: no file, or no table)."""
+    if params is None:
+        return None
+    from ..actuator import load_thresholds
+
+    return load_thresholds(params) or None
 
 
 def _checked_inputs(

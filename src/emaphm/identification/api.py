@@ -48,6 +48,7 @@ def identify(
     channel_map: Any = None,
     thresholds: dict[str, float] | None = None,
     on_generation: OnGeneration | None = None,
+    actuator_id: str | None = None,
     **options: Any,
 ) -> IdentificationResult:
     """Identify the faults from `reference`, or from the HF twin run with `true_faults` (noise on).
@@ -63,6 +64,7 @@ def identify(
         files; default: the packaged ones); an LF calibration for other parameters is refused.
     thresholds : the detection thresholds ({} reports nothing; default: the shipped ones).
     on_generation : progress callback (gen, max_gen, best); a negative gen counts MCMC steps.
+    actuator_id : the actuator's id (serial, tail position), recorded as ``settings["actuator_id"]``.
     """
     s = IdentifySettings.resolve(settings, options)
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
@@ -103,6 +105,7 @@ def identify(
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
     record["doubtful_above"] = {"nrmse": doubtful[0], "source": doubtful[1]}  # `verdict.fit_limit`
     record["motion"] = motion  # `preconditions.motion_doubts`
+    record["actuator_id"] = actuator_id  # which actuator, for the report and the campaign
     return IdentificationResult(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=ident.run_.evaluations,
         wall_time_s=round(time.perf_counter() - start, 3), seed=s.seed, optimizer=s.optimizer, truth=m.truth,
