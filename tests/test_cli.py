@@ -551,3 +551,7 @@ def test_the_printed_diagnosis_names_the_actuator_and_calibrations_it_rests_on(t
     path.write_text("[motor]\nR_s = 0.6\n")
     code, _, err = run_cli(["identify", "--params", str(path), "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)
     assert code == 2 and "made for other actuator parameters" in err  # --params without its calibration
+    # the newcomer's other slip: --calibration of another actuator without its --params names the way out
+    cal = Path(__file__).resolve().parents[1] / "benchmarks" / "actuators" / "foc-textbook.cal.json"
+    code, _, err = run_cli(["identify", "--calibration", str(cal), "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)
+    assert code == 2 and "a foc drive" in err and "pass the actuator file it was made for (--params" in err

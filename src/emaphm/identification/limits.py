@@ -143,11 +143,14 @@ SECOND_SEARCH_NRMSE: dict[str, float] = {"default": 0.03, "paper": 0.05}
 # above DOUBTFUL_MARGIN x the DOUBTFUL_QUANTILE of the fits the interval calibration measured on its
 # random twin cases (``emaphm calibrate-uq``, noise on; its record's ``fit``). Without such a record
 # (an older file, or none) the second search's trigger of the monitor stands in, and the result says so.
-# The margin: the packaged calibration's 160 cases (a third of the faults absent) fit to p99 1.99 %,
-# max 2.15 %, while cases with every fault present fit worse (the Table 1 case 2.69 %, seed 3/1;
-# bench_multifault's chirp cases up to 2.79 %): 1.5 x p99 = 2.99 % holds them
-DOUBTFUL_QUANTILE = 0.99
-DOUBTFUL_MARGIN = 1.5
+# The packaged calibration's 160 cases (a third of the faults absent) fit to 1.32 / 1.75 / 1.99 /
+# 2.15 % (median / p90 / p99 / max), while cases with every fault present fit worse (the Table 1
+# case 2.69 %, seed 3/1; bench_multifault's chirp cases up to 2.79 %): 1.7 x p90 = 2.98 % holds
+# them. The p90, not the p99: a few of an FOC drive's random cases lie beyond its monitor (two
+# shorts >= 0.45 make its current loop unstable, docs/theory/hf-model.md §4b) and fit to up to 43 %,
+# which carries the textbook drive's p99 to 8.7 % while its p90 is 1.77 %
+DOUBTFUL_QUANTILE = 0.9
+DOUBTFUL_MARGIN = 1.7
 
 # ---- the motion's preconditions (`preconditions`) ----
 # the measured surface may lead or trail the monitor's at the estimate by this much [s] before the
