@@ -129,9 +129,8 @@ class Calibration:
                 f"{where} was made for other actuator parameters (hash {params_hash(made_for)}, these are "
                 f"{params_hash(params)}): {'; '.join(differ[:2])}"
                 f"{f' and {len(differ) - 2} more' if len(differ) > 2 else ''}; "
-                "if the calibration is this actuator's, pass the actuator file it was made for (--params, "
-                "params=); else calibrate the monitor for these ('emaphm calibrate --params FILE --output "
-                "cal.json', or emaphm.calibrate(params=...)) and pass that calibration"
+                "if it is this actuator's, pass the actuator file it was made for (--params, params=); else "
+                "calibrate the monitor for these ('emaphm calibrate --params FILE --output cal.json') and pass it"
             )
 
     def to_json(self) -> dict[str, Any]:

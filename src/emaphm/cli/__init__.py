@@ -14,6 +14,7 @@ One module per group of commands, registered below in the order ``emaphm --help`
 - `simulate`: ``simulate``, ``demo``
 - `identify`: ``identify``
 - `calibrate`: ``calibrate``, ``calibrate-uq``, ``calibrate-detection``
+- `baseline`: ``baseline``
 - `data`: ``convert``, ``inspect``
 - `actuator`: ``params``, ``thresholds``
 - `prognostics`: ``rul``
@@ -32,7 +33,7 @@ import typer
 
 from .._version import __version__
 from ..errors import InputError, SimulationError
-from . import actuator, calibrate, campaign, data, identify, prognostics, simulate
+from . import actuator, baseline, calibrate, campaign, data, identify, prognostics, simulate
 
 __all__ = ["app", "main"]
 
@@ -66,6 +67,7 @@ app.command()(identify.identify)
 app.command()(calibrate.calibrate)
 app.command("calibrate-uq")(calibrate.calibrate_uq)
 app.command("calibrate-detection")(calibrate.calibrate_detection)
+app.command()(baseline.baseline)
 app.command()(data.convert)
 app.command("inspect")(data.inspect_command)
 app.command()(simulate.demo)

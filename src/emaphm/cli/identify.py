@@ -59,6 +59,14 @@ ReportOption = Annotated[
     Path | None,
     typer.Option(help="Also write a report to this folder: figures and a self-contained index.html."),
 ]
+BaselineOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--baseline",
+        help="This actuator's baseline folder from 'emaphm baseline': its actuator file, calibrations and "
+        "thresholds (then not given otherwise).",
+    ),
+]
 ActuatorIdOption = Annotated[
     str | None,
     typer.Option(
@@ -80,6 +88,7 @@ def identify(
     params: ParamsNeedCalibrationOption = None,
     report: ReportOption = None,
     actuator_id: ActuatorIdOption = None,
+    baseline: BaselineOption = None,
     **options: Any,
 ) -> None:
     """Identify the fault vector from a measured (or simulated) quadrature current.
@@ -94,16 +103,25 @@ def identify(
     from ..io import atomic_path
 
     settings = settings_from_options(options)
+    if baseline is not None:  # its files stand for these options: refused beside it, or missing, now
+        from ..baseline import baseline_inputs
+
+        given = {"--params": params, "--calibration": calibration, "--uq-calibration": uq_calibration,
+                 "--detection": detection}  # fmt: skip
+        files = baseline_inputs(baseline, **given)
     truth, thresholds = _checked_inputs(
         true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
         detection=detection,
     )  # fmt: skip
     failure = _failure_thresholds(params) if report is not None else None  # a bad table: refused now
+    if baseline is not None:
+        params, thresholds = files["params"], files["thresholds"]  # for the report
     with progress() as update:
         result = run_identify(
             truth, reference, settings=settings, calibration=calibration, uq_calibration=uq_calibration,
-            params=params, channel_map=map_file, thresholds=thresholds, actuator_id=actuator_id,
+            params=None if baseline else params, channel_map=map_file, thresholds=None if baseline else thresholds,
+            actuator_id=actuator_id, baseline=baseline,
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else f"{settings.optimizer.upper()} generations", abs(gen), total
             ),
@@ -129,7 +147,9 @@ def identify(
         typer.echo(json.dumps(data))
     else:
         print_identification(data)
-    if data["verdict"] != "fits":  # ran, but no diagnosis, or a doubtful one: a script must not take it for sure
+    if (
+        data["verdict"] != "fits"
+    ):  # ran, but no diagnosis, or a doubtful one: a script must not take it for sure
         raise typer.Exit(3 if data["verdict"] == "does not fit" else 4)
 
 
@@ -172,7 +192,9 @@ def _checked_inputs(
         ChannelMap.load(map_file)  # a bad map: refused before the work
     if output is not None:
         check_output_path(
-            output, suffixes=(".json",), inputs=(reference, calibration, uq_calibration, params, map_file, detection)
+            output,
+            suffixes=(".json",),
+            inputs=(reference, calibration, uq_calibration, params, map_file, detection),
         )
     if report is not None:
         from ..report import check_report_dir

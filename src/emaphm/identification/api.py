@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -49,6 +50,7 @@ def identify(
     thresholds: dict[str, float] | None = None,
     on_generation: OnGeneration | None = None,
     actuator_id: str | None = None,
+    baseline: str | os.PathLike[str] | None = None,
     **options: Any,
 ) -> IdentificationResult:
     """Identify the faults from `reference`, or from the HF twin run with `true_faults` (noise on).
@@ -65,12 +67,20 @@ def identify(
     thresholds : the detection thresholds ({} reports nothing; default: the shipped ones).
     on_generation : progress callback (gen, max_gen, best); a negative gen counts MCMC steps.
     actuator_id : the actuator's id (serial, tail position), recorded as ``settings["actuator_id"]``.
+    baseline : a folder from `emaphm.baseline` (``emaphm baseline``): the actuator's own file,
+        calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``.
     """
     s = IdentifySettings.resolve(settings, options)
+    params, calibration, uq_calibration, thresholds, used = _with_baseline(
+        baseline, params, calibration, uq_calibration, thresholds
+    )
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
     start = time.perf_counter()
     noise_seed, opt_seed = split_seed(s.seed)
     m = measurement(true_faults, reference, channel_map, actuator, noise_seed)
+    if used is not None and used["current_gain"] != 1.0:  # the sensor's gain the baseline measured
+        signals = {**m.trace.signals, "i_q": m.trace.i_q / used["current_gain"]}
+        m = replace(m, trace=SimResult(t=m.trace.t, signals=signals, metadata=m.trace.metadata))
     doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
     ident = FaultIdentifier(
         s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation, doubtful_nrmse=doubtful[0]
@@ -79,32 +89,26 @@ def identify(
         ident.fit(m.trace.t, m.trace.i_q, m.command, m.theta_u)
     warnings = [
         *(m.conversion or {}).get("warnings", []),
-        *recording_warnings(
-            ident.context_,
-            m.trace.t,
-            m.trace.theta_cmd,
-            monitor.calibration,
-            thresholds,
-            command_rate(m.conversion),
-        ),
-    ]
+        *recording_warnings(ident.context_, m.trace.t, m.trace.theta_cmd, monitor.calibration, thresholds,
+                            command_rate(m.conversion)),
+    ]  # fmt: skip
     interval = None
     if factors is not None and explains(ident.fit_nrmse_):
         interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings)
     warnings += fit_warnings(ident.fit_nrmse_)
     warnings += fit_doubts(ident.fit_nrmse_, *doubtful, ident.record("second_search"))
-    motion_warnings, motion = (
-        motion_doubts(ident.context_, ident.faults_, m.trace.t, m.theta_u)
-        if explains(ident.fit_nrmse_)
-        else ([], None)
+    explained = explains(ident.fit_nrmse_)
+    moved, motion = (
+        motion_doubts(ident.context_, ident.faults_, m.trace.t, m.theta_u) if explained else ([], None)
     )
-    warnings += motion_warnings
+    warnings += moved
     doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
     doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
     detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds)
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
     record["doubtful_above"] = {"nrmse": doubtful[0], "source": doubtful[1]}  # `verdict.fit_limit`
     record["motion"] = motion  # `preconditions.motion_doubts`
+    record["baseline"] = used  # `baseline.baseline_inputs`; None: the nameplate
     record["actuator_id"] = actuator_id  # which actuator, for the report and the campaign
     return IdentificationResult(
         estimate=ident.faults_, fitness=ident.fitness_, evaluations=ident.run_.evaluations,
@@ -113,6 +117,25 @@ def identify(
         fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged, curves=ident.curves(),
         doubts=doubts,
     )  # fmt: skip
+
+
+def _with_baseline(
+    baseline: Any, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
+) -> tuple[Any, ...]:
+    """The inputs a baseline folder gives (`baseline.baseline_inputs`) and its record; as given without one."""
+    if baseline is None:
+        return params, calibration, uq_calibration, thresholds, None
+    from ..baseline import baseline_inputs
+
+    b = baseline_inputs(baseline, params=params, calibration=calibration, uq_calibration=uq_calibration,
+                        thresholds=thresholds)  # fmt: skip
+    return (
+        b["params"],
+        b["calibration"],
+        b["uq_calibration"],
+        b["thresholds"],
+        {**b["record"], "current_gain": b["current_gain"]},
+    )
 
 
 def _inputs(

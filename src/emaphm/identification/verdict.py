@@ -51,15 +51,26 @@ def fit_distribution(fits: Any) -> dict[str, Any]:
 def fit_limit(record: dict[str, Any] | None, monitor: str) -> tuple[float, str]:
     """The NRMSE above which a fit is "doubtful", and where it comes from: the interval
     calibration's measured fits (its record's ``data["fit_nrmse"]``, `fit_distribution`), else the
-    monitor's second-search trigger (`limits.SECOND_SEARCH_NRMSE`)."""
-    fits = ((record or {}).get("data") or {}).get("fit_nrmse")
+    monitor's second-search trigger (`limits.SECOND_SEARCH_NRMSE`); with a baseline's own healthy
+    fits (``baseline["fit_nrmse"]``, `emaphm.baseline`), at least `limits.DOUBTFUL_MARGIN` x the
+    poorest of them: how well the monitor explains this actuator when healthy."""
+    record = record or {}
+    fits = (record.get("data") or {}).get("fit_nrmse")
+    limit, source = (
+        limits.SECOND_SEARCH_NRMSE.get(monitor, limits.FIT_NRMSE_WARN),
+        "no twin fits measured; the monitor's default",
+    )
     if fits:
         measured = fit_distribution(fits)
         if measured["cases"] >= 20:
-            return measured["doubtful_above"], f"the interval calibration's {measured['cases']} twin cases"
-    return limits.SECOND_SEARCH_NRMSE.get(
-        monitor, limits.FIT_NRMSE_WARN
-    ), "no twin fits measured; the monitor's default"
+            limit, source = (
+                measured["doubtful_above"],
+                f"the interval calibration's {measured['cases']} twin cases",
+            )
+    own = [f for f in (record.get("baseline") or {}).get("fit_nrmse", []) if np.isfinite(f)]
+    if own and limits.DOUBTFUL_MARGIN * max(own) > limit:
+        limit, source = limits.DOUBTFUL_MARGIN * max(own), f"the baseline's {len(own)} healthy recordings"
+    return limit, source
 
 
 def explains(fit_nrmse: float | None) -> bool:
