@@ -62,7 +62,11 @@ def test_the_folder_holds_what_identify_needs_bound_together(folder):
     params = load_params(folder / FILES["params"])
     calibration = load_calibration(folder / FILES["calibration"])
     MonitorEma(params, calibration=calibration)  # the calibration is the fitted actuator's: no refusal
-    assert load_factors(folder / FILES["uq_calibration"]).matches(calibration)
+    factors = load_factors(folder / FILES["uq_calibration"])
+    assert factors.matches(calibration)
+    # the constants' covariance, which widens each diagnosis' intervals: positive definite on the fitted ones
+    cov = np.array(factors.record["constants"]["log_covariance"])
+    assert cov.shape == (7, 7) and np.all(np.linalg.eigvalsh(cov) > 0)
     text = (folder / FILES["params"]).read_text()
     assert "current sensor's gain" in text and "90 % interval" in text and "sha256" in text
     assert "<table>" in (folder / "index.html").read_text()
@@ -78,6 +82,7 @@ def test_identify_with_the_baseline_reads_the_short_right_where_the_nameplate_do
     assert err_based <= 3.0 < err_alone and err_based < 0.6 * err_alone
     assert based.settings["baseline"]["directory"] == str(folder) and based.settings["baseline"]["current_gain"] > 1.04
     assert alone.settings["baseline"] is None
+    assert based.uncertainty.details["constants_from"].startswith("the baseline's fit")
 
 
 def test_recordings_of_two_actuators_are_refused_with_the_reason(healthy, tmp_path):

@@ -91,7 +91,7 @@ def params_from_dict(data: dict[str, Any], where: str = "actuator file") -> EmaP
         raws[key] = raw
 
     for key, raw in data.items():
-        if key == "thresholds":  # the failure thresholds of prognostics: `load_thresholds`
+        if key in ("thresholds", "tolerances"):  # `load_thresholds`, `constants.load_tolerances`
             continue
         if isinstance(raw, dict):
             if key not in groups:

@@ -45,7 +45,7 @@ _WHAT = {
     "i_gain": "the current sensor's gain (identify divides the current by it)",
     "k_t_eq": "the monitor's torque gain k_t,eq", "k_e_eq": "the back-EMF gain k_e,eq (psi_m)",
     "J_eq": "the inertia J_eq (J_m, J_u)", "F_S0": "static friction F_S0", "F_D0": "dynamic friction F_D0",
-    "B0": "backlash B0", "K_P0": "the position gain K_P0 as it acts",
+    "K_P0": "the position gain K_P0 as it acts",
 }  # fmt: skip
 
 
@@ -155,6 +155,8 @@ def _uq(made: Baseline, calibration: Any, given: Any) -> Factors:
     record["lf_calibration"] = {"monitor": calibration.monitor, "created": calibration.record["created"],
                                 "params_hash": calibration.params_hash}  # fmt: skip
     record["baseline"] = {"fit_nrmse": list(made.fit.fit_nrmse), "from": str(given or "packaged")}
+    # the constants' covariance (log-factors), which widens every diagnosis' intervals (`uncertainty.constants`)
+    record["constants"] = {"names": list(CONSTANTS), "log_covariance": made.fit.details["log_covariance"]}
     return Factors(nameplate.scale, nameplate.floor, record)
 
 

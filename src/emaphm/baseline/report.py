@@ -24,7 +24,6 @@ _NAMEPLATE = {
     "J_eq": ("J_eq", "kg·m²", lambda b: b.calibration.coefficients.J_eq / b.fit.factors["J_eq"]),
     "F_S0": ("F_S0", "N·m", lambda b: b.nameplate.transmission.F_S0),
     "F_D0": ("F_D0", "N·m", lambda b: b.nameplate.transmission.F_D0),
-    "B0": ("B0", "rad", lambda b: b.nameplate.transmission.B0),
     "K_P0": ("K_P0 as it acts", "A/rad", lambda b: b.nameplate.controller.K_P0),
 }  # fmt: skip
 

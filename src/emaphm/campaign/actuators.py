@@ -24,7 +24,7 @@ __all__ = ["ID_PATTERN", "CampaignActuator", "parse_actuator", "parse_fleet"]
 
 ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 ACTUATOR_KEYS = {"id", "faults", "reference", "references", "map", "flights", "start", "growth", "law", "params",
-                 "calibration"}  # fmt: skip
+                 "calibration", "baseline"}  # fmt: skip
 FLEET_KEYS = {"prefix", "count", "seed", "faults", "absent", "flights", "start", "growth", "law", "params",
               "calibration"}  # fmt: skip
 LAWS = ("linear", "exponential")
@@ -162,6 +162,20 @@ def parse_fleet(f: Any, index: int, folder: Path, where: str) -> list[CampaignAc
     ]
 
 
+def _baseline_folder(value: Any, folder: Path, at: str) -> Path:
+    """The baseline folder `value` names, relative to the campaign's folder, checked (`baseline.baseline_files`)."""
+    from ..baseline import baseline_files
+
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{at}: baseline must be a folder path, got {value!r}")
+    p = (folder / value).resolve()
+    try:
+        baseline_files(p)
+    except InputError as exc:
+        raise InputError(f"{at}: {exc}") from None
+    return p
+
+
 def _file(value: Any, key: str, folder: Path, at: str) -> Path:
     """The file `value` names, relative to the campaign's folder; `InputError` if there is none."""
     if not isinstance(value, str) or not value:
@@ -202,6 +216,8 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
         return _file(value, key, folder, at)
 
     overrides = {k: str(path(a[k], k)) for k in ("params", "calibration") if k in a}
+    if "baseline" in a:  # the actuator's own baseline folder (`emaphm baseline`): its files stand for those
+        overrides["baseline"] = str(_baseline_folder(a["baseline"], folder, at))
     channel_map = path(a["map"], "map") if "map" in a else None
     if kind == "faults":
         return CampaignActuator(

@@ -45,7 +45,9 @@ growth = [[0.01, 0.02], [0.004, 0.009], 0, 0, 0, 0, 0, 0]
 ```
 
 - Paths are relative to the campaign file. An actuator may carry its own ``params`` and
-  ``calibration`` (another type of actuator in the fleet); they override ``[identify]``'s.
+  ``calibration`` (another type of actuator in the fleet); they override ``[identify]``'s. Or its
+  own ``baseline`` folder (``emaphm baseline``): its actuator file, calibrations and thresholds
+  stand for ``[identify]``'s files, and its files' digests enter the job key.
 - Flights: a one-off measurement (``faults``, ``reference``) is flight 0; histories number their
   flights 1..N. Linear: k(n) = start + growth·(n − 1); exponential: k(n) = start·e^{growth·(n − 1)}
   (growth is then a rate per flight, and a fault that starts at 0 stays at 0); both clipped to
@@ -88,7 +90,6 @@ __all__ = ["CampaignSpec", "Job", "history_seed", "load_campaign"]
 TOP_KEYS = {"campaign", "identify", "actuator", "fleet"}
 CAMPAIGN_KEYS = {"name", "seeds", "description"}
 # identify() settings a campaign may set, with their checks; file paths resolved to the spec's folder
-
 
 
 def history_seed(seed: int, flight: int) -> int:
@@ -157,21 +158,30 @@ class CampaignSpec:
 
         def digest(path: Path) -> str:
             if path not in digests:
-                if not path.is_file():
+                if path.is_dir():  # a baseline folder: the digest of its files' digests
+                    from ..baseline import baseline_files
+
+                    parts = "".join(sha256_of(f) for f in baseline_files(path).values())
+                    digests[path] = hashlib.sha256(parts.encode()).hexdigest()
+                elif not path.is_file():
                     raise InputError(f"{self.source}: no such file {path}")
-                digests[path] = sha256_of(path)
+                else:
+                    digests[path] = sha256_of(path)
             return digests[path]
 
         out = []
         prints: dict[str, str] = {}  # one fingerprint per distinct settings (a fleet shares them)
         for act in self.actuators:
             settings = {**self.settings, **act.overrides}
+            if "baseline" in settings:  # its actuator file and calibrations stand for the campaign's
+                settings = {k: v for k, v in settings.items() if k not in IDENTIFY_FILES}
+            files = (*IDENTIFY_FILES, "baseline")
             hashed = {
-                k: (digest(Path(v)) if k in IDENTIFY_FILES and v is not None else v) for k, v in settings.items()
+                k: (digest(Path(v)) if k in files and v is not None else v) for k, v in settings.items()
             }
             text = json.dumps(settings, sort_keys=True, default=str)
             if text not in prints:
-                prints[text] = fingerprint(settings, digest, IDENTIFY_FILES)
+                prints[text] = fingerprint(settings, digest, files)
             cmap = str(act.channel_map) if act.channel_map is not None else None
             flights: list[tuple[int, tuple[float, ...] | None, Path | None]]
             if act.kind == "faults":

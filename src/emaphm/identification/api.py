@@ -94,7 +94,7 @@ def identify(
     ]  # fmt: skip
     interval = None
     if factors is not None and explains(ident.fit_nrmse_):
-        interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings)
+        interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings, params)
     warnings += fit_warnings(ident.fit_nrmse_)
     warnings += fit_doubts(ident.fit_nrmse_, *doubtful, ident.record("second_search"))
     explained = explains(ident.fit_nrmse_)
@@ -188,10 +188,14 @@ def _intervals(
     seed: int,
     on_step: OnGeneration | None,
     warnings: list[str],
+    params: Any = None,
 ) -> Uncertainty | None:
     """Stage 6: the Laplace intervals about the estimate (with ``mcmc``, the posterior's from
-    them); what makes them doubtful is appended to `warnings`."""
+    them), widened for what the actuator's constants may move (`uncertainty.constants`: a
+    baseline's fit, else the actuator file `params`' tolerances); what makes them doubtful is
+    appended to `warnings`."""
     from .uncertainty import laplace
+    from .uncertainty.constants import constants_covariance
 
     calibration = ident.monitor_.calibration
     made_with = factors.record.get("last_stage", "none") if factors.record else None
@@ -210,8 +214,10 @@ def _intervals(
     interval = None
     with numba_threads(s.workers):
         try:
+            cov_c, source = constants_covariance(factors.record, params)
             interval = laplace(ident.final_objective_, ident.monitor_, ident.faults_, duration=ident.duration_,
-                               factors=factors)  # fmt: skip
+                               factors=factors, constants_cov=cov_c)  # fmt: skip
+            interval.details["constants_from"] = source
         except InputError as exc:  # the estimate stands; only its intervals cannot be given
             warnings.append(f"no intervals: {exc}; faults are detected by the point rule")
         if interval is not None and s.uncertainty == "mcmc":

@@ -36,7 +36,6 @@ __all__ = [
 ]  # fmt: skip
 
 
-
 def integrated_time(r: ArrayLike, c: float = SOKAL_C) -> float:
     """Integrated autocorrelation time of the series r [samples], with Sokal's adaptive window:
     τ(M) = 1 + 2·Σ_{t=1..M} ρ(t), at the smallest M ≥ c·τ(M) (as `emcee.autocorr`). White noise
@@ -118,8 +117,11 @@ def laplace(
     *,
     duration: float | None = None,
     factors: Factors | None = None,
+    constants_cov: NDArray[np.float64] | None = None,
 ) -> Uncertainty:
-    """Laplace intervals about the estimate k̂ (module docstring): one population call of 33 rows."""
+    """Laplace intervals about the estimate k̂ (module docstring): one population call of 33 rows.
+    `constants_cov`: the covariance of the actuator's constants' log-factors (`emaphm.constants`),
+    whose effect on k̂ widens the calibrated intervals (`constants.shift_covariance`)."""
     k_hat = np.asarray(k_hat, dtype=np.float64)
     u0 = to_cartesian(k_hat)[0]
     factors = factors if factors is not None else Factors.identity()
@@ -163,7 +165,9 @@ def laplace(
     for jj in np.flatnonzero(ratio > NONSMOOTH_RATIO):
         flags_extra[int(jj)].append("nonsmooth")
     combos = _weak_directions(JtJ, raw, flags_extra)
-    std, lo, hi, flags = intervals(k_hat, factors.apply(raw))
+    calibrated, added = _widened(factors.apply(raw), objective, monitor, k_hat, (R, rows, spans, u0, n), constants_cov,
+                                 duration)  # fmt: skip
+    std, lo, hi, flags = intervals(k_hat, calibrated)
     for j in range(N_PARAMS):
         flags[j] += flags_extra[j]
     sd_k = np.sqrt(np.clip(np.diag(cov_k), 0.0, np.inf))
@@ -181,8 +185,25 @@ def laplace(
         "steps": list(LAPLACE_STEPS),
         "non_identifiable": combos,
         "calibrated": bool(factors.record),
+        "constants_std": None if constants_cov is None else [round(float(a), 6) for a in added],
     }
     return Uncertainty("laplace", std, lo, hi, corr, flags, raw, len(rows), details, cov_u)
+
+
+def _widened(calibrated: NDArray[np.float64], objective: Fitness, monitor: MonitorEma, k_hat: NDArray[np.float64],
+             runs: tuple, constants_cov: NDArray[np.float64] | None, duration: float | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The calibrated σ widened by what the constants' covariance moves (`constants.shift_covariance`), and that part."""
+    added = np.zeros(N_PARAMS)
+    if constants_cov is None:
+        return calibrated, added
+    from .constants import shift_covariance
+
+    R, rows, spans, u0, n = runs
+    shift_u = shift_covariance(
+        objective, monitor, k_hat, _jacobian(R, rows, spans, u0, 0, n), constants_cov, duration
+    )
+    added = np.sqrt(np.clip(np.diag(_delta_to_faults(u0, shift_u)), 0.0, np.inf))
+    return np.sqrt(calibrated**2 + added**2), added
 
 
 def _jacobian(
