@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -126,3 +127,20 @@ def test_the_doubtful_limit_follows_the_baseline_s_own_healthy_fits():
     assert fit_limit({**twin, "baseline": {"fit_nrmse": [0.005, 0.006]}}, "default")[0] == limit  # no looser
     poorer, source = fit_limit({**twin, "baseline": {"fit_nrmse": [0.02, 0.03]}}, "default")
     assert poorer == pytest.approx(emaphm.identification.limits.DOUBTFUL_MARGIN * 0.03) and "baseline" in source
+
+
+def test_a_nameplate_without_its_calibration_starts_from_the_packaged_one_and_says_so(healthy, tmp_path, capsys):
+    nameplate = tmp_path / "nameplate.toml"
+    nameplate.write_text("[motor]\nR_s = 0.55\n")
+    code, _, err = run_cli(["baseline", str(healthy[0]), "--params", str(nameplate), "--output", str(tmp_path / "W")],
+                           capsys)  # fmt: skip
+    assert code == 0 and "the packaged one (made for the paper's actuator) was the start" in " ".join(err.split())
+    record = json.loads((tmp_path / "W" / FILES["record"]).read_text())
+    assert record["warm_start"] and load_params(tmp_path / "W" / FILES["params"]).motor.R_s == 0.55
+    # the folder is bound to the fitted actuator: identify takes it without --params or --calibration
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, seed=1, baseline=tmp_path / "W", pop_size=6, generations=1,
+                        polish=False, uncertainty="none")  # fmt: skip
+    assert r.settings["baseline"]["directory"] == str(tmp_path / "W")
+    # a calibration given for another actuator is still refused
+    with pytest.raises(InputError, match="made for other actuator parameters"):
+        make_baseline([healthy[0]], params=nameplate, calibration=Path(emaphm.__file__).parent / "data" / "calibration.json")

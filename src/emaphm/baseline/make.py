@@ -68,7 +68,7 @@ def make_baseline(
         raise InputError("give at least one recording of the healthy actuator")
     start = time.perf_counter()
     nameplate = resolve_params(params)
-    monitor = MonitorEma(nameplate, calibration=calibration)  # the calibration must be the nameplate's
+    monitor, warm = _monitor(nameplate, calibration)
     settings = IdentifySettings()
     contexts = []
     for i, rec in enumerate(recordings):
@@ -96,12 +96,29 @@ def make_baseline(
         "recordings": [{"file": str(r), "sha256": sha256_of(r), "fit_nrmse": round(f, 6),
                         "nameplate_fit_nrmse": round(s, 6)} for r, f, s in zip(recordings, fit.fit_nrmse, fit.start_nrmse, strict=True)],
         "channel_map": None if channel_map is None else str(channel_map),
+        # the calibration the fit started from, when it was made for another actuator (`_monitor`)
+        "warm_start": warm,
         "factors": {c: _factor_record(fit, c) for c in CONSTANTS},
         "alone": [{c: round(a.factors[c], 6) for c in CONSTANTS} for a in alone],
         "fit": fit.details,
         "wall_time_s": round(time.perf_counter() - start, 2),
     }  # fmt: skip
     return Baseline(fitted, cal, fit, record, nameplate, contexts)
+
+
+def _monitor(nameplate: Any, calibration: Any) -> tuple[MonitorEma, str | None]:
+    """The nameplate's monitor, and None; with no calibration given for a nameplate the packaged
+    one was not made for, the packaged one's coefficients as the start (what moves with the
+    constants is refitted; the rest is the packaged actuator's) and a sentence saying so."""
+    try:
+        return MonitorEma(nameplate, calibration=calibration), None
+    except InputError:
+        if calibration is not None:
+            raise  # a calibration given for another actuator: refused as identify refuses it
+    return MonitorEma(nameplate, allow_mismatch=True), (
+        "no calibration was given for this nameplate: the packaged one (made for the paper's actuator) "
+        "was the start; calibrating the monitor for the nameplate ('emaphm calibrate --params') is better"
+    )
 
 
 def _twin_contexts(contexts: list[Any], nameplate: Any, monitor: MonitorEma, settings: Any) -> list[Any]:

@@ -63,6 +63,8 @@ def baseline(
             progress=update,
         )  # fmt: skip
     folder = write_baseline(made, output, uq_calibration=uq_calibration, detection=detection)
+    if made.record["warm_start"]:
+        err.print(f"emaphm: warning: {made.record['warm_start']}", soft_wrap=True)
     for c, entry in made.record["factors"].items():
         low, high = entry["ci90"]
         err.print(f"{c:>7}: {entry['factor']:.4f} x the nameplate (90 % interval {low:.4f}-{high:.4f})")
