@@ -61,22 +61,21 @@ def collect_cases(
     progress: Progress | None = None,
     params: EmaParams | None = None,
     drive_tolerance: float = 0.0,
+    tolerance: float = 0.0,
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
-    "raw_std", "fit_nrmse"} arrays (one row per case) and "skipped", the cases the monitor could not
-    explain. The draws do not depend on `cases`: a longer set extends a shorter one, `first` resumes
-    one. Of an FOC drive with `drive_tolerance` > 0, each case's twin is drawn about `params`
-    (`tolerances.drawn_actuator`: the PI gains within ±drive_tolerance, the carrier's phase).
+    "raw_std", "added_std" (the constants' part, `uncertainty.constants`), "fit_nrmse"} arrays (one
+    row per case) and "skipped", the cases the monitor could not explain. The draws do not depend on
+    `cases`: a longer set extends a shorter one, `first` resumes one. Each case's twin is drawn
+    about `params` (`tolerances.drawn_actuator`) with `tolerance` > 0, or of an FOC drive with
+    `drive_tolerance` > 0 (the PI gains, the carrier's phase).
 
     Parameters
     ----------
     cases, seed : int
         The number of cases and the seed of their draws.
-    calibration : Calibration or path, optional
-        The LF calibration (default: the packaged one).
-    monitor : {"default", "paper"}, optional
-        The monitor model (None: the calibration's).
+    calibration, monitor : the LF calibration (default: the packaged one) and the monitor model (None: its).
     absent : float
         Probability that each fault of a case is absent (healthy value), in [0, 1].
     first : int
@@ -85,8 +84,8 @@ def collect_cases(
         ``progress(stage, done, total)`` after each case.
     params : EmaParams, optional
         The actuator (default: the paper's nominal one).
-    drive_tolerance : float
-        Of an FOC drive, the spread of the drawn twins' PI gains (0: the actuator's own twin).
+    drive_tolerance, tolerance : float
+        The spread of the drawn twins' PI gains (FOC) and of their constants (0: the actuator's own twin).
     """
     from ..identification.api import identify
     from ..identification.recording import split_seed
@@ -94,7 +93,7 @@ def collect_cases(
     from ..tolerances import drawn_actuator
 
     actuator = params if params is not None else EmaParams()
-    drawn = actuator.inverter.foc and drive_tolerance > 0
+    drawn = (actuator.inverter.foc and drive_tolerance > 0) or tolerance > 0
     K = random_faults(cases, seed, absent=absent)[first:]
     kept: list[tuple[Any, ...]] = []  # (truth, estimate, raw σ, fit NRMSE) of each usable case
     walls, skipped = [], []
@@ -102,7 +101,7 @@ def collect_cases(
         run_seed = 1000 * seed + i
         source: dict[str, Any] = {"true_faults": k}
         if drawn:  # the twin of an actuator drawn about this one, measured as identify's twin would be
-            plant = drawn_actuator(actuator, run_seed, drive_tolerance=drive_tolerance)
+            plant = drawn_actuator(actuator, run_seed, tolerance=tolerance, drive_tolerance=drive_tolerance)
             source = {"reference": HighFidelityEma(plant).simulate(k, seed=split_seed(run_seed)[0])}
         r = identify(
             **source, seed=run_seed, calibration=calibration, monitor=monitor,
@@ -111,7 +110,8 @@ def collect_cases(
         if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
             skipped.append({"case": i, "faults": k.tolist(), "fit_nrmse": r.fit_nrmse})
         else:
-            kept.append((k, r.estimate, r.uncertainty.raw_std, r.fit_nrmse))
+            added = getattr(r.uncertainty, "details", {}).get("constants_std") or [0.0] * len(k)
+            kept.append((k, r.estimate, r.uncertainty.raw_std, r.fit_nrmse, added))  # (added: `constants`)
         walls.append(r.wall_time_s)
         if progress is not None:
             progress("identifications", i + 1, cases)
@@ -124,7 +124,7 @@ def collect_cases(
     return {
         **{
             name: np.array([c[j] for c in kept]).reshape(rows)
-            for j, name in enumerate(("truths", "estimates", "raw_std"))
+            for j, name in zip((0, 1, 2, 4), ("truths", "estimates", "raw_std", "added_std"), strict=True)
         },
         "fit_nrmse": np.array([c[3] for c in kept], dtype=np.float64),
         "skipped": skipped,
@@ -141,6 +141,7 @@ def calibrate_uq(
     progress: Progress | None = None,
     params: EmaParams | str | os.PathLike[str] | None = None,
     drive_tolerance: float = DRIVE_TOLERANCE,
+    tolerance: float = 0.0,
 ) -> Factors:
     """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
 
@@ -165,10 +166,12 @@ def calibrate_uq(
         its carrier at a random phase (`tolerances.drawn_actuator`), so that the intervals hold on
         drives that differ from the file in what a data sheet does not fix; no effect on a
         hysteresis drive.
+    tolerance : float
+        Each case's twin drawn with its motor and drive-train constants within ±tolerance
+        (`tolerances.drawn_actuator`; 0: the exact twin). Either way the factors are fitted to the
+        intervals as identify gives them, widened for the constants (`identification.uncertainty.
+        constants`), so that the widening is not counted twice.
     """
-    from ..identification.last_stage import resolve_last_stage
-    from ..identification.weights import resolve_error_corner
-
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
         raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
@@ -179,10 +182,23 @@ def calibrate_uq(
     start = time.perf_counter()
     data = collect_cases(
         cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator,
-        drive_tolerance=drive_tolerance,
+        drive_tolerance=drive_tolerance, tolerance=tolerance,
     )  # fmt: skip
-    fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"])
-    record = {
+    fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"], added=data["added_std"])
+    record = _record(lf, actuator, data, report, cases=cases, seed=seed, drive_tolerance=drive_tolerance,
+                     tolerance=tolerance, wall=time.perf_counter() - start)  # fmt: skip
+    return Factors(fitted.scale, fitted.floor, record)
+
+
+def _record(
+    lf: Calibration, actuator: EmaParams, data: dict[str, Any], report: dict[str, Any], *, cases: int, seed: int,
+    drive_tolerance: float, tolerance: float, wall: float,
+) -> dict[str, Any]:  # fmt: skip
+    """The interval calibration's record: how it was made, on what, and its cases' data."""
+    from ..identification.last_stage import resolve_last_stage
+    from ..identification.weights import resolve_error_corner
+
+    return {
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "method": "laplace",
         "lf_calibration": {
@@ -200,15 +216,17 @@ def calibrate_uq(
         "absent": UQ_ABSENT,
         # of an FOC drive, the spread of the drawn twins' PI gains (0: the actuator's own twin)
         "drive_tolerance": float(drive_tolerance) if actuator.inverter.foc else 0.0,
+        # the actuators' constants drawn within ±tolerance (`tolerances.drawn_actuator`), and each
+        # interval widened for them as identify widens it (`uncertainty.constants`)
+        "tolerance": float(tolerance),
         "skipped": data["skipped"],
-        "form": "sigma = sqrt((scale * sigma_raw)^2 + floor^2); the narrowest median interval covering coverage_target of these cases",
+        "form": "sigma = sqrt((scale * sigma_raw)^2 + floor^2 + sigma_constants^2); the narrowest median interval covering coverage_target of these cases",
         "coverage_target": FIT_COVERAGE,
         "training": report,
         "fit": fit_distribution(data["fit_nrmse"]),  # how well it explains its twin (`verdict.fit_limit`)
-        "wall_time_s": round(time.perf_counter() - start, 1),
+        "wall_time_s": round(wall, 1),
         "versions": versions(),
         "data": {
             k: np.asarray(v).round(6).tolist() for k, v in data.items() if k not in ("wall_time_s", "skipped")
         },
     }
-    return Factors(fitted.scale, fitted.floor, record)

@@ -99,6 +99,12 @@ def calibrate_uq(
             "no effect on a hysteresis drive."
         ),
     ] = 0.1,
+    tolerance: Annotated[
+        float,
+        typer.Option(
+            help="Draw each case's motor and drive-train constants within ±this (relative; 0: the exact twin)."
+        ),
+    ] = 0.0,
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from ..actuator import resolve_params
@@ -112,19 +118,22 @@ def calibrate_uq(
         raise InputError(f"--cases must be >= 20 (coverage needs a sample), got {cases}")
     if not 0.0 <= drive_tolerance < 1.0:
         raise InputError(f"--drive-tolerance must be in [0, 1), got {drive_tolerance:g}")
+    if not 0.0 <= tolerance < 0.5:
+        raise InputError(f"--tolerance must be in [0, 0.5), got {tolerance:g}")
     check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
     actuator = resolve_params(params)
     MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
     with numba_threads(workers, name="--workers"), progress() as update:
-
         report = logged(update)
         factors = run_calibrate_uq(
             cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
-            params=actuator, drive_tolerance=drive_tolerance,
+            params=actuator, drive_tolerance=drive_tolerance, tolerance=tolerance,
         )  # fmt: skip
     factors.save(output)
     for case in factors.record["skipped"]:
-        err.print(f"left out case {case['case']}: the monitor does not explain it (NRMSE {case['fit_nrmse']:.3g})")
+        err.print(
+            f"left out case {case['case']}: the monitor does not explain it (NRMSE {case['fit_nrmse']:.3g})"
+        )
     for name, fit in factors.record["training"].items():
         err.print(f"{name}: coverage {fit['coverage']:.2f}, median half-width {fit['median_half_width']:.4f}")
     err.print(f"wrote {output} ({cases} cases, seed {seed}, {factors.record['wall_time_s']:.0f} s)")
@@ -135,11 +144,17 @@ def calibrate_detection(
         Path, typer.Option("--output", "-o", help="Detection thresholds file to write (JSON).")
     ] = Path("detection.json"),
     runs: Annotated[
-        int, typer.Option(help="Healthy identifications for the thresholds, and as many to count false alarms.")
+        int,
+        typer.Option(help="Healthy identifications for the thresholds, and as many to count false alarms."),
     ] = 20,
-    seed: Annotated[int, typer.Option(help="Seed of the first healthy run (the false alarms' start 1000 later).")] = 1000,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the first healthy run (the false alarms' start 1000 later).")
+    ] = 1000,
     sensitivity: Annotated[
-        bool, typer.Option("--sensitivity/--no-sensitivity", help="Also check that each single fault of 0.1 is detected.")
+        bool,
+        typer.Option(
+            "--sensitivity/--no-sensitivity", help="Also check that each single fault of 0.1 is detected."
+        ),
     ] = True,
     calibration: CalibrationOption = None,
     monitor: MonitorOption = None,
@@ -154,7 +169,6 @@ def calibrate_detection(
     check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
     settings = IdentifySettings(monitor=monitor, workers=workers)  # the rest as identify's defaults
     with progress() as update:
-
         report = logged(update)
         record = run_calibrate_detection(
             params=params, calibration=calibration, settings=settings, runs=runs, threshold_seed=seed,

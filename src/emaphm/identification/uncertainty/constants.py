@@ -29,10 +29,12 @@ __all__ = ["BASELINE_FLOOR", "STEP", "constants_covariance", "shift_covariance"]
 
 STEP = 0.01  # the log-factor step of the central differences (1 %: well above the kernel's rounding)
 # a baseline's constants are uncertain to at least this fraction of the tolerances' band: its fit is
-# the monitor's, which leaves R_s, L_s, the drive and the integration unfitted. With its Laplace
-# covariance alone, the 90 % intervals held the truth 0.796 of the time on twins drawn within ±2 %
-# (bench_baseline.py, 6 actuators, 30 runs; 0.916 with the nameplate and the tolerances)
-BASELINE_FLOOR = 0.5
+# the monitor's, which leaves R_s, L_s, the drive and the integration unfitted. On twins drawn within
+# ±2 % (bench_baseline.py, 6 actuators, 30 runs, the packaged interval calibration fitted to the
+# widened intervals) the baseline's 90 % intervals held the truth 0.770 of the time with 0.5, 0.867
+# with 0.75 and 0.894 with 1 (the nameplate's 0.854): the baseline moves the intervals to where the
+# truth is (%err 2.24 -> 1.31 median), it does not yet make them narrower
+BASELINE_FLOOR = 1.0
 
 
 def shift_covariance(

@@ -146,15 +146,21 @@ def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str 
     return Factors.from_json(data, str(p))
 
 
-
-
 def fit_factors(
-    estimates: ArrayLike, raw_std: ArrayLike, truths: ArrayLike, *, coverage: float = FIT_COVERAGE
+    estimates: ArrayLike,
+    raw_std: ArrayLike,
+    truths: ArrayLike,
+    *,
+    coverage: float = FIT_COVERAGE,
+    added: ArrayLike | None = None,
 ) -> tuple[Factors, dict[str, Any]]:
     """The scale and floor per fault that give `coverage` of the 90 % intervals on these cases with
     the narrowest median interval (a grid search; k7 scored only where the true ζ ≥ 0.05, on the
-    circle). Returns the factors and, per fault, the coverage and median half-width reached."""
+    circle). `added`: each case's σ from the actuator's constants (`constants.shift_covariance`),
+    which the intervals add in quadrature to the calibrated one. Returns the factors and, per
+    fault, the coverage and median half-width reached."""
     E, S, T = (np.array(a, dtype=np.float64, ndmin=2) for a in (estimates, raw_std, truths))
+    A = np.zeros_like(S) if added is None else np.array(added, dtype=np.float64, ndmin=2)
     if not (E.shape == S.shape == T.shape and E.shape[1] == N_PARAMS):
         raise ValueError("estimates, raw_std and truths must all have shape (m, 8)")
     scales = np.geomspace(0.3, 30.0, 61)
@@ -168,7 +174,9 @@ def fit_factors(
         for c, b in grid:
             trial_s, trial_b = scale.copy(), floor.copy()
             trial_s[j], trial_b[j] = c, b
-            _, lo, hi, _ = intervals(E, Factors(trial_s, trial_b).apply(S), with_flags=False)
+            _, lo, hi, _ = intervals(
+                E, np.sqrt(Factors(trial_s, trial_b).apply(S) ** 2 + A**2), with_flags=False
+            )
             cov = float(covers(lo, hi, T)[rows, j].mean())
             width = float(np.median(half_widths(lo, hi)[rows, j]))
             if cov >= coverage and (best is None or width < best[2]):
