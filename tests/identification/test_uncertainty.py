@@ -147,14 +147,19 @@ def test_verdicts_tell_present_absent_and_cannot_tell():
     assert verdicts(np.r_[0.005, k[1:]], np.r_[0.0, lo[1:]], hi, {"friction": 0.01})["friction"] == "absent"
 
 
-def test_fit_factors_recovers_a_known_inflation():
-    rng = np.random.default_rng(3)
-    m = 400
+def _inflated_cases(seed, m=400):
+    """Random truths and estimates whose errors are 3x the noise-only σ (0.01), k7 on the circle."""
+    rng = np.random.default_rng(seed)
     truth = rng.uniform(0.2, 0.8, (m, 8))
     truth[:, 5] = rng.uniform(0.1, 0.3, m)
     raw = np.full((m, 8), 0.01)
-    estimates = truth + 3.0 * raw * rng.normal(size=(m, 8))  # errors 3x the noise-only σ
+    estimates = truth + 3.0 * raw * rng.normal(size=(m, 8))
     estimates[:, 6] = np.mod(estimates[:, 6], 1.0)
+    return estimates, raw, truth
+
+
+def test_fit_factors_recovers_a_known_inflation():
+    estimates, raw, truth = _inflated_cases(3)
     factors, report = fit_factors(estimates, raw, truth)
     for j in range(8):
         assert report_coverage(report, j) >= 0.9
@@ -164,14 +169,8 @@ def test_fit_factors_recovers_a_known_inflation():
 def test_fit_factors_leave_to_the_constants_what_they_already_explain():
     # errors of 3x the noise σ, of which the constants' part (added in quadrature) explains 2.8x:
     # the factors then only make up the rest, and the whole σ still comes to about 3x
-    rng = np.random.default_rng(4)
-    m = 400
-    truth = rng.uniform(0.2, 0.8, (m, 8))
-    truth[:, 5] = rng.uniform(0.1, 0.3, m)
-    raw = np.full((m, 8), 0.01)
-    estimates = truth + 3.0 * raw * rng.normal(size=(m, 8))
-    estimates[:, 6] = np.mod(estimates[:, 6], 1.0)
-    added = np.full((m, 8), 0.028)
+    estimates, raw, truth = _inflated_cases(4)
+    added = np.full(raw.shape, 0.028)
     factors, report = fit_factors(estimates, raw, truth, added=added)
     alone, _ = fit_factors(estimates, raw, truth)
     own = np.hypot(factors.scale * 0.01, factors.floor)
