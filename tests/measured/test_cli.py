@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+import emaphm
 from emaphm.io import read_trace, sha256_of
 from tests.helpers import run_cli
 from tests.measured.helpers import write_csv
@@ -91,3 +92,25 @@ def test_identify_reads_a_recording_through_its_map(rig, capsys):
     conversion = data["settings"]["conversion"]
     assert abs((conversion["angle"]["offset_deg"] - OFFSET_DEG + 180) % 360 - 180) < 1.0
     assert conversion["source"]["sha256"] == sha256_of(rig / "rig.csv")
+
+
+@pytest.mark.slow  # two healthy twin runs, a baseline and a small identification from the shell, ~10 s
+def test_a_baseline_from_rig_files_through_their_map_then_identify_with_it(tmp_path, capsys):
+    # issue 33's contract: emaphm baseline H1.csv H2.csv --map H1.toml --output DIR, then identify
+    # --reference REC.csv --map REC.toml --baseline DIR
+    for name, faults, seed in (("h1", emaphm.HEALTHY, 61), ("h2", emaphm.HEALTHY, 62), ("rec", [0.2, 0, 0, 0.3, 0, 0, 0, 0.5], 63)):
+        twin = emaphm.simulate(faults, seed=seed)
+        theta_e = np.degrees(np.mod(twin["theta_e"] - np.radians(OFFSET_DEG), 2 * np.pi))
+        write_csv(tmp_path / f"{name}.csv", {"time": twin.t * 1e3, "cmd": np.degrees(twin.theta_cmd),
+                                              "pos": np.degrees(twin.theta_u), "Ia": twin["i_a"] * 1e3,
+                                              "Ib": twin["i_b"] * 1e3, "elec": theta_e})  # fmt: skip
+    (tmp_path / "rig.toml").write_text(MAP % ("mA", "mA"))
+    code, _, err = run_cli(["baseline", str(tmp_path / "h1.csv"), str(tmp_path / "h2.csv"), "--map",
+                            str(tmp_path / "rig.toml"), "--output", str(tmp_path / "DIR")], capsys)  # fmt: skip
+    assert code == 0 and "identify --baseline" in " ".join(err.split())
+    code, out, _ = run_cli(["identify", "--reference", str(tmp_path / "rec.csv"), "--map", str(tmp_path / "rig.toml"),
+                            "--baseline", str(tmp_path / "DIR"), "--json", "--pop-size", "16", "--generations", "3",
+                            "--no-polish", "--uncertainty", "none"], capsys)  # fmt: skip
+    data = json.loads(out)
+    assert code in (0, 4) and data["settings"]["baseline"]["directory"] == str(tmp_path / "DIR")
+    assert data["settings"]["params"]["source"].endswith("actuator.toml")

@@ -74,5 +74,5 @@ def baseline(
     )
     err.print(f"healthy fits at the nameplate -> the baseline: {fits}")
     err.print(
-        f"wrote {folder} in {made.record['wall_time_s']:.1f} s: use it with 'emaphm identify --baseline {folder}'"
+        f"wrote {folder} (the fit took {made.record['wall_time_s']:.1f} s): use it with 'emaphm identify --baseline {folder}'"
     )
