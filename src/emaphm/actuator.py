@@ -239,7 +239,20 @@ def params_template(params: EmaParams | None = None) -> str:
                 extra = ""
             text = f"{prefix}{name} = {value}".ljust(width)
             lines.append(text + f"  # [{meta[name]['unit']}] {meta[name]['doc']}")
-    return "\n".join(lines) + "\n"
+    return "\n".join([*lines, "", *_TOLERANCES_TEMPLATE]) + "\n"
+
+
+# the optional [tolerances] table, commented out at its defaults (`constants.TOLERANCES`)
+_TOLERANCES_TEMPLATE = (
+    "# How far this actuator may be from the values above (relative, a uniform band): the fault",
+    "# intervals widen for what that can move (docs/uncertainty.md). These are the defaults.",
+    "# [tolerances]",
+    "# psi_m = 0.02          # the magnet flux",
+    "# J = 0.02              # the inertia",
+    "# friction = 0.02       # both friction levels",
+    "# current_gain = 0.0    # the current sensor's gain",
+    "# K_P = 0.0             # the position loop's gain as it acts",
+)
 
 
 def load_thresholds(path: str | os.PathLike[str]) -> dict[str, float]:

@@ -76,3 +76,14 @@ def test_a_flux_tolerance_widens_the_shorts_and_twice_the_tolerance_twice_as_muc
     assert np.array_equal(r0.estimate, r1.estimate)
     assert np.all(np.array(r1.uncertainty.ci90_high) >= np.array(r0.uncertainty.ci90_high) - 1e-12)
     assert "tolerances of" in r1.uncertainty.details["constants_from"]
+
+
+def test_the_template_shows_the_tolerances_table_at_its_defaults(tmp_path):
+    from emaphm.actuator import params_template
+
+    lines = [line[2:] if line.startswith("# ") and ("=" in line or "[tolerances]" in line) else line
+             for line in params_template().splitlines()]  # fmt: skip
+    start = lines.index("[tolerances]")
+    path = tmp_path / "a.toml"
+    path.write_text("\n".join(lines[start:]) + "\n")
+    assert load_tolerances(path) == TOLERANCES and "[tolerances]" not in params_template().replace("# [tolerances]", "")
