@@ -16,6 +16,7 @@ written by this process (workers need no shared file system) in batches, every `
 rows or `flush_seconds`, each batch atomically (`store.ResultStore.write`); an interruption
 loses at most the unflushed rows, which the rerun recomputes. A job that raises (or whose worker
 dies, `KilledWorker`) is written to ``failures`` and the campaign goes on; the rerun tries it again.
+At the end the store's part files are compacted (`store.ResultStore.compact`).
 """
 
 from __future__ import annotations
@@ -110,6 +111,7 @@ def run_campaign(
             backend, n_workers = run_dask(todo, address, workers or cores, collector.finished, ready)
     finally:
         collector.flush(force=True)
+    store.compact()  # many small part files into one per campaign: a fleet's reads take seconds, not minutes
     return CampaignSummary(
         campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo), stale=stale,
         kept_stale=keep_stale,

@@ -5,6 +5,13 @@ Layout under the output folder::
     results/campaign=<name>/actuator=<id>/part-<uuid>.parquet     one row per finished job
     failures/campaign=<name>/actuator=<id>/part-<uuid>.parquet    one row per failed attempt
 
+and, after `ResultStore.compact` (the end of each ``campaign run``), the rows of many part files
+merged into one, sorted by actuator, with ``campaign`` and ``actuator`` as columns::
+
+    compact/<kind>/campaign=<name>/part-<uuid>.parquet
+
+(a store of 10 000 actuators is otherwise 10 000 folders, which take seconds to list and open).
+
 Every part file is written whole to ``.part-<uuid>.parquet.tmp`` in its folder, flushed to disk
 and renamed into place (`os.replace`, atomic on one file system): a reader sees a complete file
 or none, and dataset discovery skips names that start with ``.``. A process killed mid-write
@@ -24,6 +31,7 @@ campaign's workers, so that workers × threads stay within the cores) and the ``
 
 from __future__ import annotations
 
+import contextlib
 import os
 import uuid
 from collections.abc import Iterable, Sequence
@@ -104,15 +112,78 @@ class ResultStore:
             written.append(folder / name)
         return written
 
+    def loose_parts(self) -> int:
+        """How many part files are not compacted (`compact`)."""
+        return sum(1 for _ in self.root.glob("*/campaign=*/actuator=*/part-*.parquet"))
+
+    def compact(self, min_files: int = 64, batch: int = 2000) -> int:
+        """Merge each campaign's part files of both kinds, `batch` at a time, into compacted files,
+        when there are at least `min_files` of them; the number of part files merged. Each merged
+        file is written atomically before its sources are removed: an interruption between the two
+        leaves rows twice, which the reader reads once (`_latest_per_job`)."""
+        merged = 0
+        for kind in ("results", "failures"):
+            for folder in sorted((self.root / kind).glob("campaign=*")):
+                parts = sorted(folder.glob("actuator=*/part-*.parquet"))
+                if len(parts) < min_files:
+                    continue
+                for i in range(0, len(parts), batch):  # the memory of `batch` files' rows at a time
+                    self._merge(kind, folder.name, parts[i : i + batch])
+                merged += len(parts)
+        return merged
+
+    def _merge(self, kind: str, campaign_folder: str, parts: list[Path]) -> None:
+        """Write the rows of `parts` as one compacted file of ``kind``, then remove them."""
+        _, _, pq = _pyarrow()
+        table = self._dataset(kind, parts).to_table()
+        out = self.root / "compact" / kind / campaign_folder
+        out.mkdir(parents=True, exist_ok=True)
+        name = f"part-{uuid.uuid4().hex}.parquet"
+        tmp = out / f".{name}.tmp"
+        try:
+            with tmp.open("wb") as fh:
+                pq.write_table(table.sort_by("actuator"), fh, row_group_size=8192)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, out / name)
+        finally:
+            tmp.unlink(missing_ok=True)
+        for part in parts:
+            part.unlink(missing_ok=True)
+            with contextlib.suppress(OSError):  # a folder a concurrent write still fills stays
+                part.parent.rmdir()
+
     def remove_temporaries(self) -> int:
         """Delete the temporary files a killed run left behind; their number."""
         removed = 0
-        for tmp in self.root.glob("*/campaign=*/actuator=*/.part-*.parquet.tmp"):
+        for tmp in [*self.root.glob("*/campaign=*/actuator=*/.part-*.parquet.tmp"),
+                    *self.root.glob("compact/*/campaign=*/.part-*.parquet.tmp")]:  # fmt: skip
             tmp.unlink(missing_ok=True)
             removed += 1
         return removed
 
     # -- reading ----------------------------------------------------------------------------
+
+    def _dataset(self, kind: str, files: list[Path] | None = None) -> Any:
+        """The ``kind`` rows as one pyarrow dataset (None: nothing written): the partitioned part
+        files and the compacted ones, or only the partitioned `files`; every column of the full
+        schema (a part file written before a column existed reads with nulls there)."""
+        pa, ds, _ = _pyarrow()
+        base = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
+        schema = pa.schema(
+            [(n, getattr(pa, t)()) for n, t in base.items()] + [(p, pa.string()) for p in PARTITIONS]
+        )
+        partitioning = ds.partitioning(pa.schema([(p, pa.string()) for p in PARTITIONS]), flavor="hive")
+        folder, compacted = self.root / kind, self.root / "compact" / kind
+        if files is not None:
+            return ds.dataset([str(f) for f in files], format="parquet", partitioning=partitioning,
+                              partition_base_dir=str(folder), schema=schema)  # fmt: skip
+        sources = []
+        if folder.is_dir():
+            sources.append(ds.dataset(folder, format="parquet", partitioning=partitioning, schema=schema))
+        if compacted.is_dir():
+            sources.append(ds.dataset(compacted, format="parquet", schema=schema))
+        return None if not sources else sources[0] if len(sources) == 1 else ds.dataset(sources)
 
     def read(
         self,
@@ -122,22 +193,17 @@ class ResultStore:
         actuator: str | None = None,
     ) -> Any:
         """The ``kind`` dataset as a pyarrow Table (empty if nothing was written), optionally of
-        one campaign (and `actuator`) and some columns; `InputError` naming a part file that cannot be read."""
+        one campaign (and `actuator`) and some columns; one row per job key for results (its
+        latest); `InputError` naming a part file that cannot be read."""
         pa, ds, _ = _pyarrow()
         base = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
         names = list(columns) if columns is not None else [*PARTITIONS, *base]
-        folder = self.root / kind
-        if not folder.is_dir():
-            types = {**base, "campaign": "string", "actuator": "string"}
-            return pa.table({n: pa.array([], type=getattr(pa, types[n])()) for n in names})
-        partitioning = ds.partitioning(pa.schema([(p, pa.string()) for p in PARTITIONS]), flavor="hive")
-        # the full schema: a part file written before a column existed reads with nulls there
-        schema = pa.schema(
-            [(n, getattr(pa, t)()) for n, t in base.items()] + [(p, pa.string()) for p in PARTITIONS]
-        )
         extra = [n for n in ("job_key", "finished") if n not in names]  # what the latest row per job needs
         try:
-            data = ds.dataset(folder, format="parquet", partitioning=partitioning, schema=schema)
+            data = self._dataset(kind)
+            if data is None:
+                types = {**base, "campaign": "string", "actuator": "string"}
+                return pa.table({n: pa.array([], type=getattr(pa, types[n])()) for n in names})
             filt = None  # the partitions asked for are the only ones read (review L5)
             for name, value in (("campaign", campaign), ("actuator", actuator)):
                 if value is not None:
@@ -145,13 +211,17 @@ class ResultStore:
                     filt = term if filt is None else filt & term
             table = data.to_table(columns=[*names, *extra], filter=filt)
         except (pa.ArrowInvalid, OSError) as exc:
-            raise InputError(f"{folder}: a part file cannot be read ({exc})".splitlines()[0]) from None
+            raise InputError(
+                f"{self.root / kind}: a part file cannot be read ({exc})".splitlines()[0]
+            ) from None
         return _latest_per_job(table).drop_columns(extra) if kind == "results" else table.drop_columns(extra)
 
     def fingerprints(self, campaign: str | None = None) -> dict[str, str | None]:
         """The fingerprint of each stored job's latest result row (None: a row made before them)."""
         table = self.read("results", campaign, columns=["job_key", "fingerprint"])
-        return dict(zip(table.column("job_key").to_pylist(), table.column("fingerprint").to_pylist(), strict=True))
+        return dict(
+            zip(table.column("job_key").to_pylist(), table.column("fingerprint").to_pylist(), strict=True)
+        )
 
     def keys(self, kind: str = "results", campaign: str | None = None) -> set[str]:
         """The job keys stored in ``kind`` (of one campaign)."""
@@ -162,6 +232,10 @@ class ResultStore:
 def _latest_per_job(table: Any) -> Any:
     """One row per job key: the one finished last (a job redone for another fingerprint, or a row
     written twice by a retried flush, is read once: review M2, H1)."""
+    import pyarrow.compute as pc
+
+    if pc.count_distinct(table.column("job_key")).as_py() == table.num_rows:
+        return table
     keys, finished = table.column("job_key").to_pylist(), table.column("finished").to_pylist()
     latest: dict[str, int] = {}
     for i, (key, when) in enumerate(zip(keys, finished, strict=True)):

@@ -33,7 +33,7 @@ import typer
 
 from .._version import __version__
 from ..errors import InputError, SimulationError
-from . import actuator, baseline, calibrate, campaign, data, identify, prognostics, simulate
+from . import actuator, baseline, calibrate, campaign, data, fleet, identify, prognostics, simulate
 
 __all__ = ["app", "main"]
 
@@ -74,6 +74,7 @@ app.command()(simulate.demo)
 app.command("params")(actuator.params_command)
 app.command()(actuator.thresholds)
 app.command()(prognostics.rul)
+app.command()(fleet.fleet)
 app.add_typer(campaign.campaign_app, name="campaign")
 
 

@@ -16,8 +16,6 @@ placeholder is not an airworthiness limit.
 
 from __future__ import annotations
 
-import json
-import math
 import os
 from typing import Any
 
@@ -26,14 +24,16 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS, parse_thresholds  # re-exported
-from .trend import DegradationTrend, RulEstimate
+from .measurements import correlations, detected, joint_normals, measurement
+from .trend import DegradationTrend, RulEstimate, predict_many
 
-__all__ = ["ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "parse_thresholds", "rul_report"]
+__all__ = [
+    "ESTIMATORS", "FAULTS", "PLACEHOLDER_THRESHOLDS", "history", "parse_thresholds", "rul_of_rows", "rul_report",
+]  # fmt: skip
 
 SAMPLES = 4000
 _NO_RUL = {"rul_median": None, "rul_p05": None, "rul_p95": None}
 ESTIMATORS = ("trend", "ukf")
-USED_VERDICTS = ("fits", "doubtful")  # of the rows kept (`rul_report`'s include_doubtful)
 
 
 def history(
@@ -57,61 +57,6 @@ def history(
     if not rows:
         raise InputError(f"actuator {actuator!r} has no history over flights (only one-off measurements)")
     return sorted(rows, key=lambda r: (r["flight"], r["seed"]))
-
-
-def _measurement(row: dict[str, Any], name: str) -> tuple[float, float] | None:
-    """(value, sd) of a fault in one row, or None where the row tells nothing about it."""
-    column = FAULTS[name][0]
-    j = int(column[1:]) - 1
-    if row.get("verdict") not in USED_VERDICTS:  # "does not fit" sizes nothing; doubtful ones chosen before
-        return None
-    flags = json.loads(row["uq_flags"]) if row.get("uq_flags") else None
-    if flags is not None and "non_identifiable" in flags[j]:
-        return None
-    sd = row.get(f"std_{column}")
-    if sd is None or not math.isfinite(sd) or sd <= 0:
-        return None
-    return float(row[column]), float(sd)
-
-
-def _correlations(rows: list[dict[str, Any]], names: list[str]) -> NDArray[np.float64]:
-    """The mean correlation between the estimates of faults `names` over the rows that sized both
-    (each identification's ``corr``; none recorded: 0), as a correlation matrix."""
-    n = len(names)
-    total, count = np.zeros((n, n)), np.zeros((n, n))
-    for row in rows:
-        corr = json.loads(row["corr"]) if row.get("corr") else None
-        if corr is None:
-            continue
-        used = [_measurement(row, name) is not None for name in names]
-        for a in range(n):
-            for b in range(a + 1, n):
-                ja, jb = (int(FAULTS[names[i]][0][1:]) - 1 for i in (a, b))
-                value = corr[ja][jb]
-                if used[a] and used[b] and value is not None and math.isfinite(value):
-                    total[a, b] += value
-                    count[a, b] += 1
-    rho = np.divide(total, count, out=np.zeros((n, n)), where=count > 0)
-    rho = rho + rho.T + np.eye(n)
-    w, V = np.linalg.eigh(rho)  # a mean of correlation matrices is one; clip rounding below 0
-    rho = (V * np.maximum(w, 1e-9)) @ V.T
-    d = np.sqrt(np.diag(rho))
-    return np.asarray(rho / np.outer(d, d), dtype=np.float64)
-
-
-def _joint_normals(rho: NDArray[np.float64], n: int, dims: int, seed: int) -> NDArray[np.float64]:
-    """(faults, n, dims) standard normal draws, fault f's correlated with fault g's by rho[f, g]
-    component by component (a Gaussian copula on the trends' posteriors)."""
-    L = np.linalg.cholesky(rho)
-    z = np.random.default_rng(seed).standard_normal((n, dims, len(rho)))
-    return np.asarray(np.moveaxis(z @ L.T, -1, 0), dtype=np.float64)
-
-
-def _detected(row: dict[str, Any], name: str) -> bool:
-    verdicts = json.loads(row["fault_verdicts"]) if row.get("fault_verdicts") else None
-    if verdicts is not None:
-        return bool(verdicts.get(name) == "present")
-    return name in (row.get("detected") or "").split(",")
 
 
 def rul_report(
@@ -154,11 +99,29 @@ def rul_report(
         Use the diagnoses with verdict "doubtful" too (default: left out, and counted in
         ``doubtful_left_out``): their faults are what the monitor found, not a sure diagnosis.
     """
+    rows = history(store, actuator, campaign)
+    return rul_of_rows(rows, actuator, at_flight=at_flight, thresholds=thresholds,
+                       inspection_interval=inspection_interval, seed=seed, estimator=estimator,
+                       include_doubtful=include_doubtful)  # fmt: skip
+
+
+def rul_of_rows(
+    rows: list[dict[str, Any]],
+    actuator: str,
+    *,
+    at_flight: int | None = None,
+    thresholds: dict[str, float] | None = None,
+    inspection_interval: float = 10.0,
+    seed: int = 0,
+    estimator: str = "trend",
+    include_doubtful: bool = False,
+) -> dict[str, Any]:
+    """`rul_report` on an actuator's rows of a store (`history`: one campaign, flights >= 1,
+    sorted by flight), for callers that read many actuators at once (`fleet`)."""
     if estimator not in ESTIMATORS:
         raise InputError(f"unknown estimator {estimator!r}; use one of {', '.join(ESTIMATORS)}")
     if estimator == "ukf":
         from . import progpy_model  # the extra is needed whether or not a fault is tracked
-    rows = history(store, actuator, campaign)
     if at_flight is not None:
         rows = [r for r in rows if r["flight"] <= at_flight]
         if not rows:
@@ -171,8 +134,11 @@ def rul_report(
     # the faults' trends drawn together: estimates of one identification are correlated (its
     # corr), and so are the trends fitted to them; this matters for the first failure
     drawn = list(tracked)
-    rho = _correlations(rows, drawn) if drawn else np.eye(0)
-    normals = _joint_normals(rho, SAMPLES, 2, seed) if drawn else None
+    rho = correlations(rows, drawn) if drawn else np.eye(0)
+    normals = joint_normals(rho, SAMPLES, 2, seed) if drawn else None
+    if estimator == "trend" and drawn:  # all at once (`predict_many`: the same as one by one)
+        assert normals is not None
+        many = predict_many([tracked[n][0] for n in drawn], [tracked[n][1] for n in drawn], t_now, normals)
     for i, name in enumerate(drawn):
         trend, threshold, entry = tracked[name]
         assert normals is not None
@@ -181,8 +147,7 @@ def rul_report(
             est = progpy_model.predict_rul(model, ukf, t_now, SAMPLES, z=normals[i])
             trends[name] = progpy_model.UkfTrend(trend, ukf)
         else:
-            est = trend.predict_rul(threshold, t_now, SAMPLES, z=normals[i])
-            trends[name] = trend
+            est, trends[name] = many[i], trend
         estimates[name] = est
         faults[name] = {**entry, "status": "tracked", **est.to_json(),
                         "prob_fail_before_next_inspection": round(est.prob_before(inspection_interval), 4)}  # fmt: skip
@@ -201,7 +166,7 @@ def _sure(rows: list[dict[str, Any]], actuator: str) -> tuple[list[dict[str, Any
     doubtful = sum(r.get("verdict") == "doubtful" for r in rows)
     if doubtful == len(rows):
         raise InputError(
-            f"all {doubtful} diagnoses of actuator {actuator!r} are doubtful (verdict \"doubtful\"): pass "
+            f'all {doubtful} diagnoses of actuator {actuator!r} are doubtful (verdict "doubtful"): pass '
             "--include-doubtful to track them anyway"
         )
     return [r for r in rows if r.get("verdict") != "doubtful"], doubtful
@@ -217,15 +182,13 @@ def _tracked(
     for name, (_, law, healthy) in FAULTS.items():
         threshold = given.get(name, PLACEHOLDER_THRESHOLDS[name])
         entry: dict[str, Any] = {"law": law, "threshold": threshold, "placeholder": name not in given}
-        onset = next((r["flight"] for r in rows if _detected(r, name)), None)
+        onset = next((r["flight"] for r in rows if detected(r, name)), None)
         if onset is None:
             faults[name] = {**entry, "status": "not detected", **_NO_RUL}
             continue
         trend = DegradationTrend(law, healthy)
         used = [
-            (r["flight"], m)
-            for r in rows
-            if r["flight"] >= onset and (m := _measurement(r, name)) is not None
+            (r["flight"], m) for r in rows if r["flight"] >= onset and (m := measurement(r, name)) is not None
         ]
         trend.update([f for f, _ in used], [m[0] for _, m in used], [m[1] for _, m in used])
         entry.update(tracked_from=onset, measurements=len(trend))
