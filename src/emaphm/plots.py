@@ -1,5 +1,7 @@
 """Figures (matplotlib, Agg backend): the HF response, the LF calibration (like the paper's Fig. 4), fits, convergence, fault vectors.
 
+The prognosis figure (`plot_rul`) lives in `emaphm.plots_rul` and is re-exported here.
+
 Each figure is a `matplotlib.figure.Figure` drawn by its own Agg canvas and written to a file: no
 pyplot, so the process's backend (an interactive user's, a notebook's) and pyplot's list of open
 figures are left alone.
@@ -9,11 +11,12 @@ from __future__ import annotations
 
 from collections.abc import Collection, Mapping
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from ._canvas import new_figure as _figure
 from .identification.signals import lowpass
+from .plots_rul import plot_rul  # re-exported: the prognosis figure
 from .results import SimResult
 
 __all__ = [
@@ -26,16 +29,6 @@ __all__ = [
     "plot_rul",
     "plot_vectors",
 ]
-
-
-def _figure(figsize: tuple[float, float]) -> Any:
-    """A new figure (constrained layout) drawn by an Agg canvas of its own, outside pyplot."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def plot_response(runs: Mapping[str, SimResult], path: Path, title: str) -> Path:
@@ -241,50 +234,5 @@ def plot_vectors(
     ax.set_ylabel("fault value [-]" + ("; whiskers: 90 % intervals" if intervals else ""))
     ax.legend(fontsize=7, ncols=3)
     ax.grid(alpha=0.3, axis="y")
-    fig.savefig(path, dpi=110)
-    return path
-
-
-def plot_rul(report: dict, path: Path) -> Path:
-    """An actuator's prognosis (`prognostics.rul_report`): per tracked fault its measurements with
-    90 % whiskers, the fitted law with its band up to the crossing, the threshold and the RUL's
-    5-95 % range; below, the distribution of the flights to the first failure."""
-    trends = report["_trends"]
-    estimates = report["_estimates"]
-    n = len(trends)
-    fig = _figure((9, 2.6 * (n + 1)))
-    axes = fig.subplots(n + 1, 1, squeeze=False)
-    t_now = report["at_flight"]
-    for ax, (name, trend) in zip(axes[:-1, 0], trends.items(), strict=False):
-        f = report["faults"][name]
-        est = estimates[name]
-        t = np.asarray(trend.t)
-        end = t_now + (est.p95 if np.isfinite(est.p95) else 2 * (t_now - t.min() + 1))
-        grid = np.linspace(t.min(), max(end, t_now + 1), 200)
-        lo, hi = trend.band(grid)
-        ax.errorbar(t, trend.k, yerr=1.645 * np.asarray(trend.sd), fmt="o", ms=3, color="k", elinewidth=0.7,
-                    label="identified (90 % interval)")  # fmt: skip
-        fitted = f"{f['law']} law" + (" (ProgPy UKF)" if report.get("estimator") == "ukf" else "")
-        ax.plot(grid, trend.value(grid), "C0", lw=1.2, label=fitted)
-        ax.fill_between(grid, lo, hi, color="C0", alpha=0.15, lw=0)
-        mark = " (placeholder)" if f["placeholder"] else ""
-        ax.axhline(f["threshold"], color="C3", lw=1, ls="--", label=f"threshold {f['threshold']:g}{mark}")
-        ax.axvline(t_now, color="0.5", lw=0.8)
-        if np.isfinite(est.p05):
-            ax.axvspan(t_now + est.p05, t_now + min(est.p95, grid[-1] - t_now), color="C3", alpha=0.08,
-                       label="RUL 5-95 %")  # fmt: skip
-        ax.set_ylabel(f"{name}\n|k - healthy|")
-        ax.legend(fontsize=7, loc="upper left")
-        ax.grid(alpha=0.3)
-    ax = axes[-1, 0]
-    first = estimates.get("first failure")
-    if first is not None:
-        finite = first.samples[np.isfinite(first.samples)]
-        if len(finite):
-            ax.hist(finite, bins=50, color="C3", alpha=0.7)
-        ax.set_title(f"flights to the first failure from flight {t_now:g}: median {first.median:.1f}, "
-                     f"5-95 % {first.p05:.1f}-{first.p95:.1f}", fontsize=9)  # fmt: skip
-    ax.set_xlabel("flights")
-    fig.suptitle(f"actuator {report['actuator']} ({report['campaign']})", fontsize=10)
     fig.savefig(path, dpi=110)
     return path

@@ -19,14 +19,15 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..faults import as_fault_vector, random_faults
+from .usage import parse_usage
 
 __all__ = ["ID_PATTERN", "CampaignActuator", "parse_actuator", "parse_fleet"]
 
 ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 ACTUATOR_KEYS = {"id", "faults", "reference", "references", "map", "flights", "start", "growth", "law", "params",
-                 "calibration", "baseline"}  # fmt: skip
+                 "calibration", "baseline", "usage"}  # fmt: skip
 FLEET_KEYS = {"prefix", "count", "seed", "faults", "absent", "flights", "start", "growth", "law", "params",
-              "calibration"}  # fmt: skip
+              "calibration", "usage"}  # fmt: skip
 LAWS = ("linear", "exponential")
 MAX_FLIGHTS = 100_000
 MAX_FLEET = 100_000
@@ -42,6 +43,7 @@ class CampaignActuator:
     references: list[Path] = field(default_factory=list)
     channel_map: Path | None = None
     overrides: dict[str, Any] = field(default_factory=dict)
+    usage: dict[str, Any] = field(default_factory=dict)  # hours, cycles, dates (`usage.parse_usage`)
 
 
 def _fail(where: str, message: str) -> InputError:
@@ -84,7 +86,7 @@ def _grow(start: Any, growth: Any, flights: int, laws: list[str]) -> list[tuple[
     n = np.arange(flights, dtype=np.float64)[:, None]  # flight 1 -> 0 growth steps
     exponential = np.array([x == "exponential" for x in laws])
     K = np.where(exponential, start * np.exp(np.clip(growth * n, None, 700.0)), start + growth * n)
-    return [tuple(float(v) for v in row) for row in np.clip(K, 0.0, 1.0)]
+    return [tuple(row) for row in np.clip(K, 0.0, 1.0).tolist()]
 
 
 def _history(a: dict[str, Any], where: str) -> list[tuple[float, ...]]:
@@ -142,6 +144,9 @@ def parse_fleet(f: Any, index: int, folder: Path, where: str) -> list[CampaignAc
     if "absent" in f and f.get("faults") != "random":
         raise InputError(f'{at}: absent goes with faults = "random"')
     overrides = {k: str(_file(f[k], k, folder, at)) for k in ("params", "calibration") if k in f}
+    usage = parse_usage(f.get("usage"), at)
+    if usage and "faults" in f:
+        raise InputError(f"{at}: usage belongs to flights: give it with flights (a history each)")
     ids = [f"{prefix}{i:0{width}d}" for i in range(count)]
     rng = np.random.default_rng(seed)
     if "faults" in f:
@@ -152,12 +157,12 @@ def parse_fleet(f: Any, index: int, folder: Path, where: str) -> list[CampaignAc
             K = random_faults(count, seed, absent=float(absent))
         else:
             K = _drawn(f["faults"], "faults", at, rng, count, faults=True)
-        return [CampaignActuator(i, "faults", truths=[tuple(float(v) for v in k)], overrides=overrides) for i, k in zip(ids, K, strict=True)]  # fmt: skip
+        return [CampaignActuator(i, "faults", truths=[tuple(float(v) for v in k)], overrides=overrides, usage=usage) for i, k in zip(ids, K, strict=True)]  # fmt: skip
     flights, laws = _history_form(f, at)
     starts = _drawn(f["start"], "start", at, rng, count, faults=True)
     growths = _drawn(f["growth"], "growth", at, rng, count, faults=False)
     return [
-        CampaignActuator(i, "history", truths=_grow(s0, g, flights, laws), overrides=overrides)
+        CampaignActuator(i, "history", truths=_grow(s0, g, flights, laws), overrides=overrides, usage=usage)
         for i, s0, g in zip(ids, starts, growths, strict=True)
     ]
 
@@ -219,12 +224,15 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
     if "baseline" in a:  # the actuator's own baseline folder (`emaphm baseline`): its files stand for those
         overrides["baseline"] = str(_baseline_folder(a["baseline"], folder, at))
     channel_map = path(a["map"], "map") if "map" in a else None
+    usage = parse_usage(a.get("usage"), at)
+    if usage and kind in ("faults", "reference"):
+        raise InputError(f"{at}: usage belongs to flights: give it with flights (a history) or references")
     if kind == "faults":
         return CampaignActuator(
             ident, "faults", truths=[_vector(a["faults"], "faults", at, faults=True)], overrides=overrides
         )
     if kind == "flights":
-        return CampaignActuator(ident, "history", truths=_history(a, at), overrides=overrides)
+        return CampaignActuator(ident, "history", truths=_history(a, at), overrides=overrides, usage=usage)
     refs = [a["reference"]] if kind == "reference" else a["references"]
     if not isinstance(refs, list) or not refs:
         raise InputError(f"{at}: references must be a non-empty list of file paths")
@@ -234,4 +242,5 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
         references=[path(r, kind) for r in refs],
         channel_map=channel_map,
         overrides=overrides,
+        usage=usage,
     )

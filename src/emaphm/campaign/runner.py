@@ -94,6 +94,8 @@ def run_campaign(
     jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work
     address, cores, serial = _backend(scheduler, workers)
     store.remove_temporaries()
+    store.write_usage(spec.name, [{"campaign": spec.name, "actuator": j.actuator, "flight": j.flight, **j.usage}
+                                  for j in jobs if j.usage and j.seed == spec.seeds[0]])  # fmt: skip
     stored = store.fingerprints(spec.name)
     stale = sum(1 for j in jobs if j.key in stored and stored[j.key] != j.fingerprint)
     todo = [j for j in jobs if j.key not in stored or (stored[j.key] != j.fingerprint and not keep_stale)]

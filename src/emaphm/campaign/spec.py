@@ -69,6 +69,7 @@ The ``[[actuator]]`` and ``[[fleet]]`` tables are read by `emaphm.campaign.actua
 from __future__ import annotations
 
 import collections
+import functools
 import hashlib
 import json
 import os
@@ -78,12 +79,13 @@ from typing import Any
 
 import numpy as np
 
-from .._version import __version__
 from ..errors import InputError
 from ..io import read_toml, sha256_of
 from .actuators import ID_PATTERN, CampaignActuator, parse_actuator, parse_fleet
 from .fingerprint import fingerprint
 from .identify_table import IDENTIFY_FILES, parse_identify
+from .keys import key_head, key_tail, key_text, truth_text
+from .usage import flight_usages
 
 __all__ = ["CampaignSpec", "Job", "history_seed", "load_campaign"]
 
@@ -92,6 +94,7 @@ CAMPAIGN_KEYS = {"name", "seeds", "description"}
 # identify() settings a campaign may set, with their checks; file paths resolved to the spec's folder
 
 
+@functools.lru_cache(maxsize=4096)  # a fleet's histories share their (seed, flight) pairs
 def history_seed(seed: int, flight: int) -> int:
     """The identification seed of flight `flight` of a history identified with campaign seed `seed`."""
     return int(np.random.SeedSequence([seed, flight]).generate_state(1)[0])
@@ -109,6 +112,7 @@ class Job:
     settings : dict  `identify`'s settings; key : str  the job's content key in the store
     fingerprint : str  what computes it: the code, the packaged data, the settings after defaults
     (`fingerprint.fingerprint`); a stored row with another was made by other code or data
+    usage : dict or None  the flight's cumulative hours and cycles and its date (`usage`); not in the key
     """
 
     campaign: str
@@ -123,6 +127,7 @@ class Job:
     settings: dict[str, Any]
     key: str = ""
     fingerprint: str = ""
+    usage: dict[str, Any] | None = None  # hours, cycles, date of the flight (`usage.flight_usage`); not in the key
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -192,17 +197,16 @@ class CampaignSpec:
                 flights = [(0, None, act.references[0])]
             else:  # one recording per flight: flight n stays flight n when later ones are added
                 flights = [(n, None, ref) for n, ref in enumerate(act.references, start=1)]
-            for flight, truth, ref in flights:
+            where = f"{self.source}: actuator {act.id!r}"
+            head = key_head(self.name, act.id)
+            tail = key_tail(hashed)
+            map_sha = None if act.channel_map is None else digest(act.channel_map)
+            usages = flight_usages(act.usage, [f for f, _, _ in flights], where)
+            for (flight, truth, ref), usage in zip(flights, usages, strict=True):
                 ref_sha = None if ref is None else digest(ref)
+                truth_json = truth_text(truth)
                 for seed in self.seeds:
-                    content = {
-                        "campaign": self.name, "actuator": act.id, "flight": flight, "seed": seed,
-                        "truth": None if truth is None else [round(v, 12) for v in truth],
-                        "reference_sha256": ref_sha,
-                        "map_sha256": None if act.channel_map is None else digest(act.channel_map),
-                        "settings": hashed, "version": __version__,
-                    }  # fmt: skip
-                    content_text = json.dumps(content, sort_keys=True, separators=(",", ":"))
+                    content_text = key_text(head, flight, map_sha, ref_sha, seed, tail, truth_json)
                     out.append(
                         Job(
                             campaign=self.name, actuator=act.id, flight=flight, seed=seed,
@@ -210,7 +214,7 @@ class CampaignSpec:
                             truth=truth, reference=None if ref is None else str(ref),
                             reference_sha256=ref_sha, channel_map=cmap,
                             settings=settings, key=hashlib.sha256(content_text.encode()).hexdigest()[:20],
-                            fingerprint=prints[text],
+                            fingerprint=prints[text], usage=usage,
                         )
                     )  # fmt: skip
         return out

@@ -60,6 +60,10 @@ FAILURE_COLUMNS: dict[str, str] = {
     "traceback": "string",  # the job's whole traceback (null in stores made before it)
     "worker": "string", "finished": "string", "version": "string",
 }  # fmt: skip
+USAGE_COLUMNS: dict[str, str] = {
+    "campaign": "string", "actuator": "string", "flight": "int64", "hours": "float64", "cycles": "float64",
+    "date": "string",
+}  # fmt: skip
 PARTITIONS = ("campaign", "actuator")
 
 
@@ -111,6 +115,39 @@ class ResultStore:
                 tmp.unlink(missing_ok=True)
             written.append(folder / name)
         return written
+
+    def write_usage(self, campaign: str, rows: Sequence[dict[str, Any]]) -> Path | None:
+        """Replace the usage of `campaign`'s flights (`USAGE_COLUMNS`, `campaign.usage`) by `rows`,
+        atomically; none written (and an old one removed) when `rows` is empty."""
+        pa, _, pq = _pyarrow()
+        target = self.root / "usage" / f"campaign={campaign}" / "usage.parquet"
+        if not rows:
+            target.unlink(missing_ok=True)
+            return None
+        target.parent.mkdir(parents=True, exist_ok=True)
+        schema = pa.schema([(n, getattr(pa, t)()) for n, t in USAGE_COLUMNS.items()])
+        table = pa.Table.from_pylist([{c: r.get(c) for c in USAGE_COLUMNS} for r in rows], schema=schema)
+        tmp = target.parent / ".usage.parquet.tmp"
+        try:
+            with tmp.open("wb") as fh:
+                pq.write_table(table, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, target)
+        finally:
+            tmp.unlink(missing_ok=True)
+        return target
+
+    def read_usage(self, campaign: str | None = None) -> Any:
+        """The usage of the flights of every campaign (or one) as a pyarrow Table (empty: none given)."""
+        pa, _, pq = _pyarrow()
+        files = sorted((self.root / "usage").glob(f"campaign={campaign or '*'}/usage.parquet"))
+        schema = pa.schema([(n, getattr(pa, t)()) for n, t in USAGE_COLUMNS.items()])
+        try:
+            tables = [pq.read_table(f, schema=schema) for f in files]
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise InputError(f"{self.root / 'usage'}: a usage file cannot be read ({exc})".splitlines()[0]) from None
+        return pa.concat_tables(tables) if tables else schema.empty_table()
 
     def loose_parts(self) -> int:
         """How many part files are not compacted (`compact`)."""

@@ -31,8 +31,15 @@ def fleet(
         ),
     ] = None,
     inspection_interval: Annotated[
-        float, typer.Option(help="Flights to the next inspection: the colours are shares of it.")
+        float, typer.Option(help="Flights (or --unit) to the next inspection: the colours are shares of it.")
     ] = 10.0,
+    unit: Annotated[
+        str,
+        typer.Option(
+            help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
+            "cycles from the campaign's usage per flight)."
+        ),
+    ] = "flights",
     include_doubtful: Annotated[
         bool,
         typer.Option("--include-doubtful", help='Track the diagnoses with verdict "doubtful" too.'),
@@ -56,7 +63,7 @@ def fleet(
     from ..prognostics.fleet_files import public, write_fleet
 
     if not inspection_interval > 0:
-        raise InputError(f"--inspection-interval must be > 0 flights, got {inspection_interval}")
+        raise InputError(f"--inspection-interval must be > 0 {unit}, got {inspection_interval}")
     if top < 0:
         raise InputError(f"--top must be >= 0, got {top}")
     if not store.is_dir():
@@ -68,7 +75,7 @@ def fleet(
     given = _thresholds(params, threshold)
     _compact(store)
     report = fleet_report(store, campaign=campaign, thresholds=given, inspection_interval=inspection_interval,
-                          seed=seed, include_doubtful=include_doubtful, charts=output is not None,
+                          seed=seed, include_doubtful=include_doubtful, charts=output is not None, unit=unit,
                           progress=_progress())  # fmt: skip
     if output is not None:
         page = write_fleet(report, output)

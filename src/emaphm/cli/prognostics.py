@@ -38,6 +38,13 @@ def rul(
     inspection_interval: Annotated[
         float, typer.Option(help="Flights to the next inspection, for the probability of failing before it.")
     ] = 10.0,
+    unit: Annotated[
+        str,
+        typer.Option(
+            help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
+            "cycles from the campaign's usage per flight)."
+        ),
+    ] = "flights",
     estimator: Annotated[
         str,
         typer.Option(
@@ -64,7 +71,7 @@ def rul(
     if plot is not None:
         check_output_path(plot, suffixes=(".png",), option="--plot")
     if not inspection_interval > 0:
-        raise InputError(f"--inspection-interval must be > 0 flights, got {inspection_interval}")
+        raise InputError(f"--inspection-interval must be > 0 {unit}, got {inspection_interval}")
     given: dict[str, float] = {}
     if params is not None:
         from ..actuator import load_thresholds
@@ -72,13 +79,13 @@ def rul(
         given.update(load_thresholds(params))
     given.update(parse_thresholds(threshold))
     report = rul_report(store, actuator, campaign=campaign, at_flight=at_flight, thresholds=given,
-                        inspection_interval=inspection_interval, estimator=estimator,
+                        inspection_interval=inspection_interval, estimator=estimator, unit=unit,
                         include_doubtful=include_doubtful)  # fmt: skip
     data = {k: v for k, v in report.items() if not k.startswith("_")}
     if plot is not None:
         from ..plots import plot_rul
 
-        plot_rul(report, plot)
+        plot_rul(report, plot, params=params)  # the actuator file's params, when given
         err.print(f"wrote {plot}")
     if json_out:
         typer.echo(json.dumps(data))

@@ -257,12 +257,19 @@ def print_rul(data: dict[str, Any]) -> None:
         out.print(
             f"first failure: median {num(first['rul_median'])} flights (5-95 % {num(first['rul_p05'])}-"
             f"{num(first['rul_p95'])}), most likely {first['most_likely_fault']}; P(before the next inspection in "
-            f"{data['inspection_interval']:g} flights) {first['prob_fail_before_next_inspection']:.2f}"
+            f"{data['inspection_interval']:g} {data.get('unit', 'flights')}) {first['prob_fail_before_next_inspection']:.2f}"
         )
+        if data.get("due"):
+            from .render_fleet import due_text
+
+            out.print(f"due: {due_text(data['due'])}")
         if first["placeholder_thresholds"]:
             out.print(f"placeholder thresholds (not limits): {', '.join(first['placeholder_thresholds'])}")
     else:
         out.print("no fault is tracked yet: nothing is predicted")
+
+
+STATUS_ROWS = 40  # actuators listed by campaign status
 
 
 def print_campaign_status(data: dict[str, Any]) -> None:
@@ -272,8 +279,13 @@ def print_campaign_status(data: dict[str, Any]) -> None:
     table = Table(title=f"campaign {data['campaign']} in {data['store']}")
     for column in ("actuator", "jobs", "done", "failed", "missing"):
         table.add_column(column, justify="left" if column == "actuator" else "right")
-    for name, c in data["actuators"].items():
+    # a fleet's actuators: those not done, up to STATUS_ROWS (--json has every one)
+    rows = [(n, c) for n, c in data["actuators"].items() if len(data["actuators"]) <= STATUS_ROWS or c["done"] < c["jobs"]]
+    for name, c in rows[:STATUS_ROWS]:
         table.add_row(name, *(str(c[k]) for k in ("jobs", "done", "failed", "missing")))
+    left = len(data["actuators"]) - min(len(rows), STATUS_ROWS)
+    if left:
+        table.add_row(f"({left} more: --json)", "", "", "", "")
     table.add_row("all", *(str(data[k]) for k in ("jobs", "done", "failed", "missing")), style="bold")
     out_console = stdout_console()
     out_console.print(table)

@@ -6,7 +6,7 @@ from typing import Any
 
 from .output import stdout_console
 
-__all__ = ["print_fleet"]
+__all__ = ["due_text", "print_fleet"]
 
 STYLE = {"red": "bold red", "orange": "dark_orange", "yellow": "yellow", "green": "green"}
 
@@ -23,15 +23,16 @@ def print_fleet(data: dict[str, Any], top: int) -> None:
     unit = data.get("unit", "flights")
     table = Table(title=f"fleet of {len(entries)} actuators, most urgent first (inspection every "
                         f"{data['inspection_interval']:g} {unit})")  # fmt: skip
-    for column in ("", "actuator", "verdict", "worst fault", "of threshold", f"RUL 5 / 50 / 95 % ({unit})",
-                   "P(fail before next)", "why"):  # fmt: skip
+    dues = any(e.get("due") for e in entries[:top])
+    for column in ("", "actuator", "verdict", "worst fault", "of threshold", "RUL 5 / 50 / 95 % (flights)",
+                   *(("due",) if dues else ()), "P(fail before next)", "why"):  # fmt: skip
         table.add_column(column, justify="right" if column.startswith(("of", "RUL", "P(")) else "left")
     for e in entries[:top]:
         rul = " / ".join(_num(e[k]) for k in ("rul_p05", "rul_median", "rul_p95"))
         table.add_row(
             f"[{STYLE[e['colour']]}]{e['colour']}[/]", e["actuator"], e["verdict"], e["worst_fault"] or "-",
-            _num(e["threshold_share"], "{:.0%}"), rul, _num(e["prob_fail_before_next_inspection"], "{:.2f}"),
-            e["reason"],
+            _num(e["threshold_share"], "{:.0%}"), rul, *((due_text(e["due"]) if e.get("due") else "-",) if dues else ()),
+            _num(e["prob_fail_before_next_inspection"], "{:.2f}"), e["reason"],
         )  # fmt: skip
     out = stdout_console()
     out.print(table)
@@ -50,3 +51,14 @@ def print_fleet(data: dict[str, Any], top: int) -> None:
             "failure thresholds are placeholders (not airworthiness limits) where no actuator file gives them: "
             "pass --params FILE or --threshold FAULT=DISTANCE"
         )
+
+
+def due_text(due: dict[str, Any]) -> str:
+    """The first failure's RUL in hours or cycles and its dates, in one line (`prognostics.usage.due`)."""
+    parts = []
+    if due.get("unit"):
+        parts.append(f"{due['rul_p05'] if due['rul_p05'] is not None else 'beyond'} {due['unit']} at 5 %, "
+                     f"{due['rul_median'] if due['rul_median'] is not None else 'beyond'} median")  # fmt: skip
+    if due.get("date_p05") or due.get("date_median"):
+        parts.append(f"on {due.get('date_p05') or 'no date'} at 5 % ({due.get('date_median') or 'beyond'} median)")
+    return "; ".join(parts) or "no usage recorded"

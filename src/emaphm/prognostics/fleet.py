@@ -34,6 +34,7 @@ from typing import Any
 from ..errors import InputError
 from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS
 from .fleet_entry import BANDS, COLOURS, colour_of, entry, thresholds_of
+from .usage import UNITS, read_usage
 
 __all__ = ["BANDS", "COLOURS", "colour_of", "fleet_report"]
 
@@ -54,6 +55,7 @@ def fleet_report(
     seed: int = 0,
     include_doubtful: bool = False,
     charts: bool = False,
+    unit: str = "flights",
     progress: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Every actuator of the results store `store` (of `campaign`), ranked by urgency (module
@@ -68,11 +70,14 @@ def fleet_report(
     thresholds : dict of str to float, optional
         Failure thresholds per fault (distance from healthy, fault units), for every actuator.
     inspection_interval : float
-        Flights to the next inspection.
+        Flights (or `unit`) to the next inspection.
     seed : int
         Seed of the RUL draws (as ``emaphm rul --seed``).
     include_doubtful : bool
         Track the doubtful diagnoses too (default: left out of the trends, and counted).
+    unit : {"flights", "hours", "cycles"}
+        The unit of `inspection_interval`, and of each entry's ``due`` RUL (`usage`: the campaign's
+        usage per flight; `InputError` for an actuator without it).
     charts : bool
         Give each entry the data of its trend chart (``_series``, `fleet_series.series`; else {}).
     progress : callable, optional
@@ -86,15 +91,17 @@ def fleet_report(
     table = ResultStore(store).read("results", campaign, columns=COLUMNS)
     if table.num_rows == 0:
         raise InputError(f"{store}: no results" + (f" of campaign {campaign!r}" if campaign else ""))
-    options = {"thresholds": thresholds, "interval": inspection_interval, "seed": seed,
-               "include_doubtful": include_doubtful, "charts": charts}  # fmt: skip
+    if unit not in UNITS:
+        raise InputError(f"unknown unit {unit!r}; use one of {', '.join(UNITS)}")
+    options = {"thresholds": thresholds, "interval": inspection_interval, "seed": seed, "unit": unit,
+               "include_doubtful": include_doubtful, "charts": charts, "usage": read_usage(store, campaign)}  # fmt: skip
     entries = _ranked_parts(table, options, progress)
     entries.sort(key=_urgency)
     counts = {c: sum(e["colour"] == c for e in entries) for c in COLOURS}
     counts.update({v: sum(e["verdict"] == v for e in entries) for v in ("doubtful", "does not fit")})
     return {
         "store": str(store), "campaign": campaign, "version": __version__,
-        "generated": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "unit": "flights",
+        "generated": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "unit": unit,
         "inspection_interval": inspection_interval, "include_doubtful": include_doubtful, "seed": seed,
         "thresholds": _threshold_table(thresholds), "counts": counts, "actuators": entries,
     }  # fmt: skip
@@ -192,8 +199,8 @@ def _entries_here(
     for i, (start, length) in enumerate(bounds):
         rows = table.slice(start, length).to_pylist()
         limits = thresholds_of(rows[-1], options["thresholds"], own)
-        entries.append(entry(rows[0]["campaign"], rows[0]["actuator"], rows, limits, options["interval"],
-                              options["seed"], options["include_doubtful"], options["charts"]))  # fmt: skip
+        key = (rows[0]["campaign"], rows[0]["actuator"])
+        entries.append(entry(key[0], key[1], rows, limits, options, options["usage"].get(key)))
         if progress is not None and i % 500 == 0:
             progress(int(i * scale), int(len(bounds) * scale))
     return entries

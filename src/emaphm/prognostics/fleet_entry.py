@@ -11,6 +11,7 @@ from ..errors import InputError
 from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS
 from .measurements import parsed
 from .rul import rul_of_rows
+from .usage import due, interval_in_flights, rates
 
 __all__ = ["BANDS", "COLOURS", "colour_of", "entry", "thresholds_of"]
 
@@ -70,18 +71,20 @@ def entry(
     actuator: str,
     rows: list[dict[str, Any]],
     limits: dict[str, float],
-    interval: float,
-    seed: int,
-    include_doubtful: bool,
-    charts: bool,
+    options: dict[str, Any],
+    usage: list[dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
-    """One actuator's line of the fleet (module docstring)."""
+    """One actuator's line of the fleet (module docstring): `rows` its diagnoses by flight, `limits`
+    its failure thresholds, `options` the fleet's (interval, unit, seed, include_doubtful, charts),
+    `usage` its flights' hours, cycles and dates (`usage.read_usage`)."""
     latest = rows[-1]
     sizing = next((r for r in reversed(rows) if r.get("verdict") in SIZES), None)
     faults = _shares(sizing, limits) if sizing is not None else {}
     worst = max(faults, key=lambda n: faults[n]["share"]) if faults else None
     share = faults[worst]["share"] if worst is not None else None
-    first, left_out, series = _rul(actuator, rows, limits, interval, seed, include_doubtful, charts)
+    rate = rates(usage, float(latest["flight"]))
+    interval = interval_in_flights(options["interval"], options["unit"], rate, actuator)
+    first, left_out, series = _rul(actuator, rows, limits, interval, options)
     p05 = first.get("rul_p05")
     if first.get("status") == "tracked":
         remaining, basis = (None, "rul") if p05 is None else (p05 / interval, "rul")
@@ -90,6 +93,9 @@ def entry(
     if share is not None and share >= 1.0:
         remaining, basis = min(1.0 - share, remaining if remaining is not None else 0.0), "exceeded"
     colour = "yellow" if sizing is None else colour_of(remaining)
+    reason = _reason(basis, worst, share, first, sizing, remaining)
+    if basis in ("exceeded", "margin") and sizing is not None and sizing["verdict"] == "doubtful":
+        reason += " (a doubtful diagnosis)"
     return {
         "actuator": actuator, "campaign": campaign, "flight": latest["flight"],
         "flights": len({r["flight"] for r in rows if r["flight"] >= 1}), "verdict": latest.get("verdict"),
@@ -101,9 +107,8 @@ def entry(
         "prob_fail_before_next_inspection": first.get("prob_fail_before_next_inspection"),
         "most_likely_fault": first.get("most_likely_fault"), "rul_status": first.get("status"),
         "remaining_share": None if remaining is None else round(remaining, 4), "remaining_basis": basis,
-        "colour": colour, "reason": _reason(basis, worst, share, first, sizing, interval)
-        + (" (a doubtful diagnosis)" if basis in ("exceeded", "margin") and sizing and sizing["verdict"] == "doubtful" else ""),
-        "doubtful_left_out": left_out, "due": None, "report": None, "_series": series,
+        "colour": colour, "reason": reason, "doubtful_left_out": left_out, "due": due(first, rate, options["unit"]),
+        "report": None, "_series": series,
     }  # fmt: skip
 
 
@@ -112,9 +117,7 @@ def _rul(
     rows: list[dict[str, Any]],
     limits: dict[str, float],
     interval: float,
-    seed: int,
-    include_doubtful: bool,
-    charts: bool,
+    options: dict[str, Any],
 ) -> tuple[dict[str, Any], int, dict[str, Any]]:
     """The first failure's RUL of an actuator's history (`rul.rul_of_rows`; {"status": why not}
     when there is none), the doubtful diagnoses left out and each tracked fault's chart series."""
@@ -122,15 +125,16 @@ def _rul(
     if not flights:
         return {"status": "one-off measurement"}, 0, {}
     try:
-        report = rul_of_rows(flights, actuator, thresholds=limits, inspection_interval=interval, seed=seed,
-                             include_doubtful=include_doubtful)  # fmt: skip
+        report = rul_of_rows(flights, actuator, thresholds=limits, inspection_interval=interval,
+                             seed=options["seed"], include_doubtful=options["include_doubtful"])  # fmt: skip
     except InputError as exc:  # all diagnoses doubtful
         return {"status": str(exc)}, sum(r.get("verdict") == "doubtful" for r in flights), {}
-    if not charts:
+    if not options["charts"]:
         return report["first_failure"], report["doubtful_left_out"], {}
     from .fleet_series import series
 
-    return report["first_failure"], report["doubtful_left_out"], series(flights, report, include_doubtful)
+    drawn = series(flights, report, options["include_doubtful"])
+    return report["first_failure"], report["doubtful_left_out"], drawn
 
 
 def _reason(
@@ -139,7 +143,7 @@ def _reason(
     share: float | None,
     first: dict[str, Any],
     sizing: dict[str, Any] | None,
-    interval: float,
+    remaining: float | None,
 ) -> str:
     """One line: why the actuator has its colour."""
     if sizing is None:
@@ -151,7 +155,7 @@ def _reason(
         if p05 is None:
             return "no failure predicted (the 5 % RUL is beyond the trend's reach)"
         return (f"first failure ({first.get('most_likely_fault') or 'a fault'}) in {p05:.1f} flights at 5 %: "
-                f"{100 * p05 / interval:.0f} % of the inspection interval")  # fmt: skip
+                f"{100 * (remaining or 0.0):.0f} % of the inspection interval")  # fmt: skip
     if worst is None:
         return "no fault sized"
     return f"no trend yet ({first.get('status')}); {worst} at {100 * (share or 0):.0f} % of its threshold"

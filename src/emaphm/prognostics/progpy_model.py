@@ -212,6 +212,7 @@ class UkfTrend(DegradationTrend):
     def __init__(self, trend: DegradationTrend, ukf: Any) -> None:
         super().__init__(trend.law, trend.healthy)
         self.t, self.k, self.sd = list(trend.t), list(trend.k), list(trend.sd)
+        self._drift = trend._drift  # the side of healthy the measurements lie on (`side`)
         J = np.array([[1.0, -float(ukf.t)], [0.0, 1.0]])  # φ = level − rate·t_last, θ = rate
         x, P = np.asarray(ukf.filter.x, dtype=np.float64), np.asarray(ukf.filter.P, dtype=np.float64)
         self._posterior = (J @ x, J @ P @ J.T)

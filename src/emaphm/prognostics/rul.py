@@ -70,6 +70,7 @@ def rul_report(
     seed: int = 0,
     estimator: str = "trend",
     include_doubtful: bool = False,
+    unit: str = "flights",
 ) -> dict[str, Any]:
     """The RUL of each tracked fault and of the first failure, as of flight `at_flight` (default:
     the last one stored), JSON-ready; see the module docstring. `estimator`: "trend"
@@ -90,7 +91,7 @@ def rul_report(
     thresholds : dict of str to float, optional
         Failure threshold per fault, in fault units from healthy (default: the placeholders).
     inspection_interval : float
-        Flights to the next inspection, for the probability of failing before it [flights].
+        Flights (or `unit`) to the next inspection, for the probability of failing before it.
     seed : int
         Seed of the draws of the first failure's distribution.
     estimator : {"trend", "ukf"}
@@ -98,11 +99,22 @@ def rul_report(
     include_doubtful : bool
         Use the diagnoses with verdict "doubtful" too (default: left out, and counted in
         ``doubtful_left_out``): their faults are what the monitor found, not a sure diagnosis.
+    unit : {"flights", "hours", "cycles"}
+        The unit of `inspection_interval` and of ``due`` (the first failure's RUL in hours or
+        cycles and its date, from the campaign's usage per flight, `usage`; null without it).
     """
+    from .usage import UNITS, due, interval_in_flights, rates, read_usage
+
+    if unit not in UNITS:
+        raise InputError(f"unknown unit {unit!r}; use one of {', '.join(UNITS)}")
     rows = history(store, actuator, campaign)
-    return rul_of_rows(rows, actuator, at_flight=at_flight, thresholds=thresholds,
-                       inspection_interval=inspection_interval, seed=seed, estimator=estimator,
-                       include_doubtful=include_doubtful)  # fmt: skip
+    now = float(at_flight if at_flight is not None else rows[-1]["flight"])
+    rate = rates(read_usage(store, rows[0]["campaign"]).get((rows[0]["campaign"], actuator)), now)
+    report = rul_of_rows(rows, actuator, at_flight=at_flight, thresholds=thresholds,
+                         inspection_interval=interval_in_flights(inspection_interval, unit, rate, actuator),
+                         seed=seed, estimator=estimator, include_doubtful=include_doubtful)  # fmt: skip
+    report.update(unit=unit, inspection_interval=inspection_interval, due=due(report["first_failure"], rate, unit))
+    return report
 
 
 def rul_of_rows(

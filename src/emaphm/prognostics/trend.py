@@ -105,7 +105,7 @@ class DegradationTrend:
     law : {"linear", "exponential"}
     healthy : float
         The fault's healthy value (0, or 0.5 for the gain drift k8): the trend is of the distance
-        from it, |k − healthy|.
+        from it, |k − healthy|; `side` says on which side of it the measurements lie.
     """
 
     def __init__(self, law: str = "linear", healthy: float = 0.0) -> None:
@@ -115,6 +115,7 @@ class DegradationTrend:
         self.t: list[float] = []
         self.k: list[float] = []
         self.sd: list[float] = []
+        self._drift = 0.0  # sum of the measurements' k − healthy, for `side`
         self._fitted: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
     # -- data -----------------------------------------------------------------------------------
@@ -130,13 +131,22 @@ class DegradationTrend:
         self.t.extend(tt[ok].tolist())
         self.k.extend(np.abs(kk[ok] - self.healthy).tolist())
         self.sd.extend(np.maximum(ss[ok], MIN_SD).tolist())
+        self._drift += float(np.sum(kk[ok] - self.healthy))
         return self
 
     def restart(self) -> DegradationTrend:
         """Forget every measurement."""
         self.t, self.k, self.sd = [], [], []
+        self._drift = 0.0
         self._fitted = None
         return self
+
+    @property
+    def side(self) -> float:
+        """+1 when the measurements lie above the healthy value on the whole, −1 below (the gain
+        drift k8 drifts either way; the other faults only grow): where a distance d lies in fault
+        units, healthy + side·d."""
+        return -1.0 if self._drift < 0 else 1.0
 
     def __len__(self) -> int:
         return len(self.t)
