@@ -45,12 +45,14 @@ SMALLEST = {
     "bench_reader": [["--cases", "1", *TINY]],
     "bench_campaign": [["--jobs", "2", "--tiny", "2", *TINY], ["--load", "10"]],
     "bench_rul_speed": [["--flights", "10", "--runs", "1"]],
+    "bench_fleet": [["--actuators", "30", "--flights", "4", "--runs", "1"]],
     "bench_rig_mistakes": [["--only", "control,current_gain_1.05", *TINY]],
     "bench_baseline": [["--actuators", "1", "--cases", "1", "--healthy", "0", *TINY]],
 }
 NEEDS = {
     "bench_campaign": ["dask.distributed", "pyarrow"],
     "bench_rul_speed": ["pyarrow"],
+    "bench_fleet": ["pyarrow", "psutil"],
     "bench_reader": [],
 }
 

@@ -133,11 +133,11 @@ def _charts(
     out: list[str | None] = []
     spent, green, over, full = 0, 0, 0, False
     for i, a in enumerate(entries):
-        series = a.get("_series") or {}
-        if a.get("verdict") == NOFIT or not series:
+        series = a.get("_series")
+        if a.get("verdict") == NOFIT or series == {}:
             out.append(None)
             continue
-        if i >= FIRST_CHARTS and a.get("colour") == "green":
+        if series is None or (i >= FIRST_CHARTS and a.get("colour") == "green"):  # None: not made (a green one)
             out.append("")
             green += 1
             continue

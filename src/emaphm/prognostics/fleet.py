@@ -79,7 +79,9 @@ def fleet_report(
         The unit of `inspection_interval`, and of each entry's ``due`` RUL (`usage`: the campaign's
         usage per flight; `InputError` for an actuator without it).
     charts : bool
-        Give each entry the data of its trend chart (``_series``, `fleet_series.series`; else {}).
+        Give each entry the data of its trend chart (``_series``, `fleet_series.series`; else {});
+        in a fleet of more than `ALL_CHARTS` actuators only those that are not green (the others'
+        ``_series`` is None: left out).
     progress : callable, optional
         Called with (actuators done, actuators) now and then.
     """
@@ -94,7 +96,8 @@ def fleet_report(
     if unit not in UNITS:
         raise InputError(f"unknown unit {unit!r}; use one of {', '.join(UNITS)}")
     options = {"thresholds": thresholds, "interval": inspection_interval, "seed": seed, "unit": unit,
-               "include_doubtful": include_doubtful, "charts": charts, "usage": read_usage(store, campaign)}  # fmt: skip
+               "include_doubtful": include_doubtful, "usage": read_usage(store, campaign),
+               "charts": charts}  # fmt: skip
     entries = _ranked_parts(table, options, progress)
     entries.sort(key=_urgency)
     counts = {c: sum(e["colour"] == c for e in entries) for c in COLOURS}
@@ -114,6 +117,8 @@ def _ranked_parts(
     process (`PARALLEL_FROM` actuators or more, and more than one core)."""
     table = table.sort_by([(c, "ascending") for c in ("campaign", "actuator", "flight", "finished", "seed")])
     bounds = _groups(table)
+    if options["charts"]:  # every chart for a small fleet, the ones not green for a large one
+        options = {**options, "charts": "all" if len(bounds) <= ALL_CHARTS else "urgent"}
     entries: list[dict[str, Any]] = []
     if len(bounds) >= PARALLEL_FROM and _cores() > 1:
         import concurrent.futures
@@ -137,6 +142,7 @@ def _ranked_parts(
     return entries
 
 
+ALL_CHARTS = 1000  # actuators up to which every one's chart data is made (above: the ones not green)
 PARALLEL_FROM = 2000  # actuators from which a second process computes half the fleet
 
 

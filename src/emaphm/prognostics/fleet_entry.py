@@ -5,6 +5,7 @@ failure threshold, its first-failure RUL, its remaining share of the inspection 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 from ..errors import InputError
@@ -96,6 +97,9 @@ def entry(
     reason = _reason(basis, worst, share, first, sizing, remaining)
     if basis in ("exceeded", "margin") and sizing is not None and sizing["verdict"] == "doubtful":
         reason += " (a doubtful diagnosis)"
+    # charts: "all", or "urgent" (a large fleet: every actuator but the green ones, whose _series is
+    # None: left out, the page says so), or none
+    wanted = options["charts"] == "all" or (options["charts"] == "urgent" and colour != "green")
     return {
         "actuator": actuator, "campaign": campaign, "flight": latest["flight"],
         "flights": len({r["flight"] for r in rows if r["flight"] >= 1}), "verdict": latest.get("verdict"),
@@ -108,7 +112,7 @@ def entry(
         "most_likely_fault": first.get("most_likely_fault"), "rul_status": first.get("status"),
         "remaining_share": None if remaining is None else round(remaining, 4), "remaining_basis": basis,
         "colour": colour, "reason": reason, "doubtful_left_out": left_out, "due": due(first, rate, options["unit"]),
-        "report": None, "_series": series,
+        "report": None, "_series": series() if wanted else (None if options["charts"] else {}),
     }  # fmt: skip
 
 
@@ -118,23 +122,25 @@ def _rul(
     limits: dict[str, float],
     interval: float,
     options: dict[str, Any],
-) -> tuple[dict[str, Any], int, dict[str, Any]]:
+) -> tuple[dict[str, Any], int, Callable[[], dict[str, Any]]]:
     """The first failure's RUL of an actuator's history (`rul.rul_of_rows`; {"status": why not}
-    when there is none), the doubtful diagnoses left out and each tracked fault's chart series."""
+    when there is none), the doubtful diagnoses left out and what makes each tracked fault's
+    chart series (`fleet_series.series`, called only for an entry that gets a chart)."""
     flights = [r for r in rows if r["flight"] >= 1]
     if not flights:
-        return {"status": "one-off measurement"}, 0, {}
+        return {"status": "one-off measurement"}, 0, dict
     try:
         report = rul_of_rows(flights, actuator, thresholds=limits, inspection_interval=interval,
                              seed=options["seed"], include_doubtful=options["include_doubtful"])  # fmt: skip
     except InputError as exc:  # all diagnoses doubtful
-        return {"status": str(exc)}, sum(r.get("verdict") == "doubtful" for r in flights), {}
-    if not options["charts"]:
-        return report["first_failure"], report["doubtful_left_out"], {}
-    from .fleet_series import series
+        return {"status": str(exc)}, sum(r.get("verdict") == "doubtful" for r in flights), dict
+    return report["first_failure"], report["doubtful_left_out"], lambda: series(flights, report, options)
 
-    drawn = series(flights, report, options["include_doubtful"])
-    return report["first_failure"], report["doubtful_left_out"], drawn
+
+def series(flights: list[dict[str, Any]], report: dict[str, Any], options: dict[str, Any]) -> dict[str, Any]:
+    from .fleet_series import series as drawn
+
+    return drawn(flights, report, options["include_doubtful"])
 
 
 def _reason(

@@ -44,7 +44,7 @@ def write_fleet(report: dict[str, Any], folder: str | os.PathLike[str]) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     data = public(report)
     with atomic_path(out / "fleet.json") as tmp:
-        tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+        tmp.write_text(json.dumps(data, separators=(",", ":")) + "\n", encoding="utf-8")
     with atomic_path(out / "fleet.csv") as tmp, tmp.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow([*CSV_COLUMNS, *(f"due_{c}" for c in DUE_COLUMNS)])
