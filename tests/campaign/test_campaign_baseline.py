@@ -60,3 +60,56 @@ def test_a_missing_baseline_folder_is_refused_naming_the_actuator(tmp_path):
     spec.write_text(SPEC.format(baseline='baseline = "nowhere"'))
     with pytest.raises(InputError, match=r"A7.*nowhere: no such folder"):
         load_campaign(spec)
+
+
+HEALTHY_SPEC = SPEC.replace("{baseline}", "{healthy}")
+
+
+def _healthy(tmp_path, seeds=(40, 41), duration=None):
+    paths = []
+    for s in seeds:
+        paths.append(tmp_path / f"h{s}.h5")
+        kw = {} if duration is None else {"duration": duration}
+        emaphm.write_trace(emaphm.simulate(emaphm.HEALTHY, seed=s, **kw), paths[-1])
+    return paths
+
+
+def test_an_actuator_with_healthy_recordings_waits_for_its_baseline(tmp_path):
+    _healthy(tmp_path, duration=0.3)
+    emaphm.write_trace(emaphm.simulate(emaphm.HEALTHY, seed=1, duration=0.3), tmp_path / "rec.h5")
+    spec = tmp_path / "c.toml"
+    spec.write_text(HEALTHY_SPEC.format(healthy='healthy = ["h40.h5", "h41.h5"]'))
+    campaign = load_campaign(spec)
+    assert campaign.jobs(tmp_path / "store") == [] and campaign.waiting(tmp_path / "store") == ["A7"]
+    status = emaphm.campaign.campaign_status(spec, tmp_path / "store")
+    assert status["waiting_for_baseline"] == ["A7"] and status["jobs"] == 0
+    for bad, message in (('healthy = []', "non-empty list"), ('healthy = ["h40.h5"]\nbaseline = "x"', "not both"),
+                         ('healthy = ["nope.h5"]', "no such file")):  # fmt: skip
+        spec.write_text(HEALTHY_SPEC.format(healthy=bad))
+        with pytest.raises(InputError, match=message):
+            load_campaign(spec)
+
+
+@pytest.mark.slow  # two baselines (~10 s each) and two identifications
+def test_the_campaign_makes_the_baseline_once_and_identifies_with_it(tmp_path):
+    healthy = _healthy(tmp_path)
+    emaphm.write_trace(emaphm.simulate([0.2, 0, 0, 0.3, 0, 0, 0, 0.5], seed=9), tmp_path / "rec.h5")
+    spec = tmp_path / "c.toml"
+    spec.write_text(HEALTHY_SPEC.format(healthy='healthy = ["h40.h5", "h41.h5"]'))
+    first = run_campaign(spec, tmp_path / "store", scheduler="serial")
+    assert (first.baselines, first.done, first.failed, first.waiting) == (1, 1, 0, ())
+    folder = tmp_path / "store" / "baselines" / "b" / "A7"
+    (row,) = ResultStore(tmp_path / "store").read().to_pylist()
+    assert json.loads(row["settings"])["baseline"] == str(folder)
+    # the same as a baseline made by hand and identify --baseline
+    by_hand = baseline(healthy, tmp_path / "by-hand")
+    alone = emaphm.identify(reference=tmp_path / "rec.h5", seed=1, baseline=by_hand, pop_size=6, generations=2,
+                            polish=False, uncertainty="none")  # fmt: skip
+    assert [row[f"k{i}"] for i in range(1, 9)] == alone.estimate.tolist()
+    again = run_campaign(spec, tmp_path / "store", scheduler="serial")
+    assert (again.baselines, again.submitted) == (0, 0)
+    # a healthy recording that is not: refused with its reason, the actuator waits
+    emaphm.write_trace(emaphm.simulate([0.6, 0.3, 0, 0.5, 0, 0, 0, 0.3], seed=41), healthy[1])
+    refused = run_campaign(spec, tmp_path / "store", scheduler="serial")
+    assert refused.failed == 1 and refused.waiting == ("A7",) and refused.failures[0].startswith("baseline of actuator A7")
+    assert folder.is_dir()  # the older baseline stays until a new one is made

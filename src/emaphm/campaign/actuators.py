@@ -25,7 +25,7 @@ __all__ = ["ID_PATTERN", "CampaignActuator", "parse_actuator", "parse_fleet"]
 
 ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 ACTUATOR_KEYS = {"id", "faults", "reference", "references", "map", "flights", "start", "growth", "law", "params",
-                 "calibration", "baseline", "usage"}  # fmt: skip
+                 "calibration", "baseline", "usage", "healthy"}  # fmt: skip
 FLEET_KEYS = {"prefix", "count", "seed", "faults", "absent", "flights", "start", "growth", "law", "params",
               "calibration", "usage"}  # fmt: skip
 LAWS = ("linear", "exponential")
@@ -44,6 +44,7 @@ class CampaignActuator:
     channel_map: Path | None = None
     overrides: dict[str, Any] = field(default_factory=dict)
     usage: dict[str, Any] = field(default_factory=dict)  # hours, cycles, dates (`usage.parse_usage`)
+    healthy: list[Path] = field(default_factory=list)  # recordings when healthy: its baseline (`baselines`)
 
 
 def _fail(where: str, message: str) -> InputError:
@@ -214,8 +215,10 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
     kind = kinds[0]
     if kind != "flights" and any(k in a for k in ("start", "growth", "law")):
         raise InputError(f"{at}: start, growth and law belong to a history (flights = N)")
-    if "map" in a and kind not in ("reference", "references"):
-        raise InputError(f"{at}: map reads a recording: give it with reference(s)")
+    if "map" in a and kind not in ("reference", "references") and "healthy" not in a:
+        raise InputError(f"{at}: map reads a recording: give it with reference(s) or healthy")
+    if "healthy" in a and "baseline" in a:
+        raise InputError(f"{at}: give baseline (a folder made) or healthy (recordings to make it from), not both")
 
     def path(value: Any, key: str) -> Path:
         return _file(value, key, folder, at)
@@ -224,15 +227,21 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
     if "baseline" in a:  # the actuator's own baseline folder (`emaphm baseline`): its files stand for those
         overrides["baseline"] = str(_baseline_folder(a["baseline"], folder, at))
     channel_map = path(a["map"], "map") if "map" in a else None
+    healthy = a.get("healthy", [])
+    if not isinstance(healthy, list) or ("healthy" in a and not healthy):
+        raise InputError(f"{at}: healthy must be a non-empty list of recordings of the actuator when healthy")
+    healthy = [path(h, "healthy") for h in healthy]
     usage = parse_usage(a.get("usage"), at)
     if usage and kind in ("faults", "reference"):
         raise InputError(f"{at}: usage belongs to flights: give it with flights (a history) or references")
     if kind == "faults":
         return CampaignActuator(
-            ident, "faults", truths=[_vector(a["faults"], "faults", at, faults=True)], overrides=overrides
-        )
+            ident, "faults", truths=[_vector(a["faults"], "faults", at, faults=True)], overrides=overrides,
+            healthy=healthy,
+        )  # fmt: skip
     if kind == "flights":
-        return CampaignActuator(ident, "history", truths=_history(a, at), overrides=overrides, usage=usage)
+        return CampaignActuator(ident, "history", truths=_history(a, at), overrides=overrides, usage=usage,
+                                healthy=healthy)  # fmt: skip
     refs = [a["reference"]] if kind == "reference" else a["references"]
     if not isinstance(refs, list) or not refs:
         raise InputError(f"{at}: references must be a non-empty list of file paths")
@@ -243,4 +252,5 @@ def parse_actuator(a: Any, index: int, folder: Path, where: str) -> CampaignActu
         channel_map=channel_map,
         overrides=overrides,
         usage=usage,
+        healthy=healthy,
     )

@@ -40,7 +40,10 @@ def run_dask(
     workers: int,
     finished: Callable[[Any, Any], None],
     ready: dict[str, float],
+    task: Callable[[dict[str, Any]], Any] = run_job,
 ) -> tuple[str, int]:
+    """Run `task` (`jobs.run_job`, or `baselines.run_baseline`) on each job of `todo` on Dask and
+    hand each result, or its failure row, to `finished`; the backend's name and its workers."""
     import dask
     from distributed import Client, LocalCluster, as_completed
 
@@ -86,7 +89,7 @@ def run_dask(
     try:
         payloads = {job.key: job.to_dict() for job in todo}
         futures = [
-            client.submit(run_job, payload, key=f"emaphm-{key}", pure=False)
+            client.submit(task, payload, key=f"emaphm-{key}", pure=False)
             for key, payload in payloads.items()
         ]
         for future in as_completed(futures):

@@ -44,7 +44,9 @@ class CampaignSummary:
     before, made by this code and data), `stale` (stored rows made by other code, data or settings:
     redone, or kept when `kept_stale`), `submitted`, `done`, `failed` (this run's) and `failures`
     (a line each, `jobs.failure_line`), `wall_time_s` and `startup_s` (the wall time, and the
-    cluster's start and warm-up before the first job [s]), `backend` and `workers` (how many at once)."""
+    cluster's start and warm-up before the first job [s]), `backend` and `workers` (how many at once),
+    `baselines` (made by this run, `baselines`) and `waiting` (actuators whose baseline is not made:
+    their identifications wait)."""
 
     campaign: str
     jobs: int
@@ -59,6 +61,8 @@ class CampaignSummary:
     stale: int = 0
     kept_stale: bool = False
     failures: tuple[str, ...] = ()
+    baselines: int = 0
+    waiting: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -91,9 +95,11 @@ def run_campaign(
     or kept with `keep_stale`; the latest row of a job is the one read."""
     spec = _spec(spec)
     store = ResultStore(out)
-    jobs = spec.jobs()  # reads every file it names: a missing one is refused before the work
+    spec.jobs(out)  # reads every file it names: a missing one is refused before the work
     address, cores, serial = _backend(scheduler, workers)
     store.remove_temporaries()
+    baselined = make_baselines(spec, out, store, address, workers or cores, serial, progress)
+    jobs = spec.jobs(out)  # now with the baselines made
     store.write_usage(spec.name, [{"campaign": spec.name, "actuator": j.actuator, "flight": j.flight, **j.usage}
                                   for j in jobs if j.usage and j.seed == spec.seeds[0]])  # fmt: skip
     stored = store.fingerprints(spec.name)
@@ -117,9 +123,11 @@ def run_campaign(
     return CampaignSummary(
         campaign=spec.name, jobs=len(jobs), already_done=len(jobs) - len(todo), submitted=len(todo), stale=stale,
         kept_stale=keep_stale,
-        done=collector.done, failed=collector.failed, failures=tuple(collector.lines),
+        done=collector.done, failed=collector.failed + baselined["failed"],
+        failures=tuple(baselined["lines"]) + tuple(collector.lines),
         wall_time_s=round(time.perf_counter() - start, 3),
         backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
+        baselines=baselined["made"], waiting=tuple(spec.waiting(out)),
     )  # fmt: skip
 
 
@@ -201,3 +209,46 @@ def _run_serial(todo: list[Any], finished: Callable[[Any, Any], None]) -> None:
             finished(None, failure_row(payload, exc))
         else:  # outside the try: a failed store write is not this job's failure (review M2)
             finished(row, None)
+
+
+def make_baselines(
+    spec: CampaignSpec,
+    out: Any,
+    store: ResultStore,
+    address: str | None,
+    workers: int,
+    serial: bool,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
+    """Make the baselines of `spec` that the store lacks (`baselines`), each installed as it
+    finishes (`progress` after each); a refused one is a failure row. How many were made and
+    failed, a line per failure."""
+    from .baselines import baseline_jobs, install, run_baseline
+
+    todo = [b for b in baseline_jobs(spec, out) if not b.made()]
+    counts: dict[str, Any] = {"made": 0, "failed": 0, "lines": []}
+    start = time.perf_counter()
+
+    def finished(made: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
+        if made is not None:
+            install(made)
+            counts["made"] += 1
+        if failure is not None:
+            store.write("failures", [failure])
+            counts["failed"] += 1
+            counts["lines"].append("baseline of " + failure_line(failure))
+        if progress is not None:
+            progress(counts["made"], counts["failed"], len(todo), time.perf_counter() - start)
+
+    if todo and serial:
+        for job in todo:
+            payload = job.to_dict()
+            try:
+                made = run_baseline(payload)
+            except Exception as exc:  # a refused baseline is the actuator's failure, the campaign goes on
+                finished(None, failure_row(payload, exc))
+            else:
+                finished(made, None)
+    elif todo:
+        run_dask(todo, address, workers, finished, {"at": 0.0}, task=run_baseline)
+    return counts

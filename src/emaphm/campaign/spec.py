@@ -157,8 +157,23 @@ class CampaignSpec:
     source: str = ""
     description: str = ""
 
-    def jobs(self) -> list[Job]:
-        """Every job of the campaign, in a stable order (actuator, flight, seed)."""
+    def waiting(self, out: str | os.PathLike[str] | None) -> list[str]:
+        """The actuators whose identifications wait for a baseline the store `out` lacks (`baselines`)."""
+        from .baselines import baseline_jobs
+
+        if not any(a.healthy for a in self.actuators):
+            return []
+        return [b.actuator for b in baseline_jobs(self, out or ".") if out is None or not b.made()]
+
+    def jobs(self, out: str | os.PathLike[str] | None = None) -> list[Job]:
+        """Every job of the campaign, in a stable order (actuator, flight, seed); an actuator with
+        ``healthy`` recordings identifies with its baseline in the store `out` (`baselines`), and
+        has no jobs until it is made (`waiting`)."""
+        from .baselines import baseline_jobs
+
+        made = {}
+        if out is not None and any(a.healthy for a in self.actuators):
+            made = {b.actuator: b.folder for b in baseline_jobs(self, out) if b.made()}
         digests: dict[Path, str] = {}
 
         def digest(path: Path) -> str:
@@ -177,7 +192,9 @@ class CampaignSpec:
         out = []
         prints: dict[str, str] = {}  # one fingerprint per distinct settings (a fleet shares them)
         for act in self.actuators:
-            settings = {**self.settings, **act.overrides}
+            if act.healthy and act.id not in made:
+                continue
+            settings = {**self.settings, **act.overrides, **({"baseline": made[act.id]} if act.healthy else {})}
             if "baseline" in settings:  # its actuator file and calibrations stand for the campaign's
                 settings = {k: v for k, v in settings.items() if k not in IDENTIFY_FILES}
             files = (*IDENTIFY_FILES, "baseline")

@@ -19,7 +19,7 @@ def campaign_status(
     ``other_rows``: stored rows of this campaign that no job of `spec` has (an older file or version)."""
     spec = spec if isinstance(spec, CampaignSpec) else load_campaign(spec)
     store = ResultStore(out)
-    jobs = spec.jobs()
+    jobs = spec.jobs(out)
     stored, failed_keys = store.fingerprints(spec.name), store.keys("failures", spec.name)
     done = set(stored)
     per: dict[str, dict[str, int]] = {}
@@ -37,4 +37,6 @@ def campaign_status(
         "other_rows": len(done - keys), "actuators": per,
         # done rows made by other code, data or settings than this version's (`campaign run` redoes them)
         "stale": sum(1 for j in jobs if j.key in stored and stored[j.key] != j.fingerprint),
+        # actuators with healthy recordings whose baseline is not made yet: their jobs wait for it
+        "waiting_for_baseline": spec.waiting(out),
     }  # fmt: skip

@@ -9,7 +9,7 @@ import typer
 
 from ..errors import InputError
 from .output import campaign_progress, err
-from .render import print_campaign_status
+from .render_campaign import print_campaign_status
 
 __all__ = ["campaign_app", "campaign_run", "campaign_status_command"]
 
@@ -62,6 +62,12 @@ def campaign_run(
         raise InputError(f"--out {out}: exists and is not a folder")
     if not out.absolute().parent.is_dir():
         raise InputError(f"--out {out}: folder {out.absolute().parent} does not exist")
+    from ..campaign.baselines import baseline_jobs
+
+    waiting = [b for b in baseline_jobs(campaign, out) if not b.made()]
+    if waiting:
+        err.print(f"campaign {campaign.name}: making {len(waiting)} baseline(s) from healthy recordings first "
+                  "(~10 s each on a core), then the identifications")  # fmt: skip
     with campaign_progress(campaign.name) as update:
         summary = run_campaign(
             campaign, out, scheduler=scheduler, workers=workers, progress=update, keep_stale=keep_stale
@@ -74,6 +80,10 @@ def campaign_run(
         f"{summary.done} done now, {summary.failed} failed ({summary.backend}, {summary.wall_time_s:.1f} s); "
         f"store {out}"
     )
+    if summary.baselines:
+        err.print(f"{summary.baselines} baseline(s) made from the actuators' healthy recordings ({out}/baselines)")
+    if summary.waiting:
+        err.print(f"{len(summary.waiting)} actuator(s) wait for their baseline: {', '.join(summary.waiting[:10])}")
     if summary.stale:
         kept = "kept (--keep-stale)" if summary.kept_stale else "redone"
         err.print(f"{summary.stale} stored result(s) were made by other code, data or settings: {kept}")
