@@ -176,3 +176,16 @@ def test_bad_input_is_one_line_and_writes_nothing(store, tmp_path, capsys, args,
     code, _, err = run_cli(args, capsys)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out").exists()
+
+
+def test_the_rows_of_a_fleet_written_at_once_are_one_file(tmp_path):
+    rows = [_row(f"B{i:03d}", f) | {"campaign": "w"} for i in range(70) for f in (1, 2)]
+    store = ResultStore(tmp_path)
+    (written,) = store.write("results", rows)
+    assert written.parent == tmp_path / "compact" / "results" / "campaign=w" and store.loose_parts() == 0
+    back = store.read("results").to_pylist()
+    assert sorted((r["actuator"], r["flight"]) for r in back) == sorted((r["actuator"], r["flight"]) for r in rows)
+    assert [r["flight"] for r in store.read("results", actuator="B007").to_pylist()] == [1, 2]
+    # a few actuators' rows stay in their own folders
+    store.write("results", rows[:4])
+    assert store.loose_parts() == 2 and store.read("results").num_rows == 140

@@ -65,6 +65,7 @@ USAGE_COLUMNS: dict[str, str] = {
     "date": "string",
 }  # fmt: skip
 PARTITIONS = ("campaign", "actuator")
+BATCH_ACTUATORS = 64  # a write of rows of this many actuators or more is one file (`ResultStore.write`)
 
 
 def _pyarrow() -> Any:
@@ -89,31 +90,28 @@ class ResultStore:
 
     def write(self, kind: str, rows: Sequence[dict[str, Any]]) -> list[Path]:
         """Append `rows` (each with ``campaign`` and ``actuator``) to ``kind`` ("results" or
-        "failures"): one part file per actuator, each written atomically."""
+        "failures"), each file written atomically: one part file per actuator, or, for rows of
+        `BATCH_ACTUATORS` actuators or more of a campaign, one compacted file (`compact`'s layout)."""
         if not rows:
             return []
-        pa, _, pq = _pyarrow()
+        pa, _, _ = _pyarrow()
         columns = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
         schema = pa.schema([(name, getattr(pa, dtype)()) for name, dtype in columns.items()])
-        groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+        groups: dict[str, dict[str, list[dict[str, Any]]]] = {}
         for row in rows:
-            groups.setdefault((row["campaign"], row["actuator"]), []).append(row)
+            groups.setdefault(row["campaign"], {}).setdefault(row["actuator"], []).append(row)
         written = []
-        for (campaign, actuator), group in groups.items():
-            folder = self.root / kind / f"campaign={campaign}" / f"actuator={actuator}"
-            folder.mkdir(parents=True, exist_ok=True)
-            table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in group], schema=schema)
-            name = f"part-{uuid.uuid4().hex}.parquet"
-            tmp = folder / f".{name}.tmp"
-            try:
-                with tmp.open("wb") as fh:
-                    pq.write_table(table, fh)
-                    fh.flush()
-                    os.fsync(fh.fileno())
-                os.replace(tmp, folder / name)
-            finally:
-                tmp.unlink(missing_ok=True)
-            written.append(folder / name)
+        for campaign, actuators in groups.items():
+            if len(actuators) >= BATCH_ACTUATORS:  # a fleet's rows at once: one file, not thousands
+                wide = pa.schema([*schema, *((p, pa.string()) for p in PARTITIONS)])
+                ordered = [{c: r.get(c) for c in wide.names} for a in sorted(actuators) for r in actuators[a]]
+                folder = self.root / "compact" / kind / f"campaign={campaign}"
+                written.append(_write_file(folder, pa.Table.from_pylist(ordered, schema=wide)))
+                continue
+            for actuator, group in actuators.items():
+                folder = self.root / kind / f"campaign={campaign}" / f"actuator={actuator}"
+                table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in group], schema=schema)
+                written.append(_write_file(folder, table))
         return written
 
     def write_usage(self, campaign: str, rows: Sequence[dict[str, Any]]) -> Path | None:
@@ -171,20 +169,8 @@ class ResultStore:
 
     def _merge(self, kind: str, campaign_folder: str, parts: list[Path]) -> None:
         """Write the rows of `parts` as one compacted file of ``kind``, then remove them."""
-        _, _, pq = _pyarrow()
         table = self._dataset(kind, parts).to_table()
-        out = self.root / "compact" / kind / campaign_folder
-        out.mkdir(parents=True, exist_ok=True)
-        name = f"part-{uuid.uuid4().hex}.parquet"
-        tmp = out / f".{name}.tmp"
-        try:
-            with tmp.open("wb") as fh:
-                pq.write_table(table.sort_by("actuator"), fh, row_group_size=8192)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, out / name)
-        finally:
-            tmp.unlink(missing_ok=True)
+        _write_file(self.root / "compact" / kind / campaign_folder, table.sort_by("actuator"))
         for part in parts:
             part.unlink(missing_ok=True)
             with contextlib.suppress(OSError):  # a folder a concurrent write still fills stays
@@ -282,3 +268,21 @@ def _latest_per_job(table: Any) -> Any:
     if len(latest) == len(keys):
         return table
     return table.take(sorted(latest.values()))
+
+
+def _write_file(folder: Path, table: Any) -> Path:
+    """Write `table` as a new part file in `folder` (made if new): whole under a hidden temporary
+    name, flushed to disk, then renamed into place."""
+    _, _, pq = _pyarrow()
+    folder.mkdir(parents=True, exist_ok=True)
+    name = f"part-{uuid.uuid4().hex}.parquet"
+    tmp = folder / f".{name}.tmp"
+    try:
+        with tmp.open("wb") as fh:
+            pq.write_table(table, fh, row_group_size=8192)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, folder / name)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return folder / name
