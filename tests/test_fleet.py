@@ -189,3 +189,18 @@ def test_the_rows_of_a_fleet_written_at_once_are_one_file(tmp_path):
     # a few actuators' rows stay in their own folders
     store.write("results", rows[:4])
     assert store.loose_parts() == 2 and store.read("results").num_rows == 140
+
+
+def test_each_charted_actuator_links_its_latest_diagnosis(tmp_path):
+    ResultStore(tmp_path / "s").write("results", [_row("ONE", 0, k2=0.30), _row("NF", 1, verdict="does not fit")])
+    from emaphm.prognostics.fleet_files import write_fleet
+
+    report = fleet_report(tmp_path / "s", charts=True)
+    write_fleet(report, tmp_path / "out")
+    by = {e["actuator"]: e for e in report["actuators"]}
+    page = (tmp_path / "out" / by["ONE"]["report"]).read_text()
+    assert "mrad (30.7 × nominal)" in page  # the free play in physical units: B0·(1 + 99·0.30)
+    assert "0.25 (exceeded)" in page  # backlash past its (placeholder) failure threshold
+    nofit = (tmp_path / "out" / by["NF"]["report"]).read_text()
+    assert "no faults are reported" in nofit and "k2 backlash" not in nofit
+    assert json.loads((tmp_path / "out" / "fleet.json").read_text())["actuators"][0]["report"] == by["ONE"]["report"]

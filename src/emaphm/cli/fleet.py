@@ -78,7 +78,10 @@ def fleet(
                           seed=seed, include_doubtful=include_doubtful, charts=output is not None, unit=unit,
                           progress=_progress())  # fmt: skip
     if output is not None:
-        page = write_fleet(report, output)
+        from ..actuator import resolve_params
+
+        page = write_fleet(report, output, params=resolve_params(params) if params is not None else None,
+                           failure=given)  # fmt: skip
         err.print(f"wrote the fleet page {page}")
     if json_out:
         import json

@@ -41,7 +41,8 @@ __all__ = ["BANDS", "COLOURS", "colour_of", "fleet_report"]
 K = [f"k{i}" for i in range(1, 9)]
 COLUMNS = [
     "campaign", "actuator", "flight", "seed", "finished", "verdict", "fault_verdicts", "uq_flags", "corr",
-    "doubts", "fit_nrmse", "settings", *K, *(f"std_{k}" for k in K), *(f"ci90_low_{k}" for k in K),
+    "doubts", "fit_nrmse", "settings", "warnings", "reference", "reference_sha256", "job_key", "identify_seed",
+    "version", "detected", *K, *(f"std_{k}" for k in K), *(f"ci90_low_{k}" for k in K),
     *(f"ci90_high_{k}" for k in K),
 ]  # fmt: skip
 

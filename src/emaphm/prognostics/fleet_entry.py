@@ -113,6 +113,7 @@ def entry(
         "remaining_share": None if remaining is None else round(remaining, 4), "remaining_basis": basis,
         "colour": colour, "reason": reason, "doubtful_left_out": left_out, "due": due(first, rate, options["unit"]),
         "report": None, "_series": series() if wanted else (None if options["charts"] else {}),
+        "_latest": latest if wanted else None,  # for its diagnosis page (`fleet_diagnosis`)
     }  # fmt: skip
 
 

@@ -35,13 +35,18 @@ def _csv_row(entry: dict[str, Any]) -> list[Any]:
     return [*("" if v is None else v for v in row), *(due.get(c, "") for c in DUE_COLUMNS)]
 
 
-def write_fleet(report: dict[str, Any], folder: str | os.PathLike[str]) -> Path:
-    """Write fleet.json, fleet.csv and index.html of `report` (`fleet.fleet_report`) into `folder`
-    (made if new); the page's path."""
+def write_fleet(
+    report: dict[str, Any], folder: str | os.PathLike[str], params: Any = None, failure: dict[str, float] | None = None
+) -> Path:
+    """Write fleet.json, fleet.csv, index.html of `report` (`fleet.fleet_report`) and the latest
+    diagnosis of each actuator with a chart (`fleet_diagnosis`, faults in the units of `params`)
+    into `folder` (made if new); the page's path."""
+    from ..fleet_diagnosis import write_diagnosis_pages
     from ..fleet_page import write_fleet_page
 
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
+    write_diagnosis_pages(report, out, params, failure)
     data = public(report)
     with atomic_path(out / "fleet.json") as tmp:
         tmp.write_text(json.dumps(data, separators=(",", ":")) + "\n", encoding="utf-8")
