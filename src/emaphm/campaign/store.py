@@ -33,12 +33,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import uuid
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from .part_files import latest_per_job, write_file
 
 __all__ = ["FAILURE_COLUMNS", "RESULT_COLUMNS", "ResultStore"]
 
@@ -106,12 +106,12 @@ class ResultStore:
                 wide = pa.schema([*schema, *((p, pa.string()) for p in PARTITIONS)])
                 ordered = [{c: r.get(c) for c in wide.names} for a in sorted(actuators) for r in actuators[a]]
                 folder = self.root / "compact" / kind / f"campaign={campaign}"
-                written.append(_write_file(folder, pa.Table.from_pylist(ordered, schema=wide)))
+                written.append(write_file(folder, pa.Table.from_pylist(ordered, schema=wide)))
                 continue
             for actuator, group in actuators.items():
                 folder = self.root / kind / f"campaign={campaign}" / f"actuator={actuator}"
                 table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in group], schema=schema)
-                written.append(_write_file(folder, table))
+                written.append(write_file(folder, table))
         return written
 
     def write_usage(self, campaign: str, rows: Sequence[dict[str, Any]]) -> Path | None:
@@ -144,7 +144,9 @@ class ResultStore:
         try:
             tables = [pq.read_table(f, schema=schema) for f in files]
         except (pa.ArrowInvalid, OSError) as exc:
-            raise InputError(f"{self.root / 'usage'}: a usage file cannot be read ({exc})".splitlines()[0]) from None
+            raise InputError(
+                f"{self.root / 'usage'}: a usage file cannot be read ({exc})".splitlines()[0]
+            ) from None
         return pa.concat_tables(tables) if tables else schema.empty_table()
 
     def loose_parts(self) -> int:
@@ -155,7 +157,7 @@ class ResultStore:
         """Merge each campaign's part files of both kinds, `batch` at a time, into compacted files,
         when there are at least `min_files` of them; the number of part files merged. Each merged
         file is written atomically before its sources are removed: an interruption between the two
-        leaves rows twice, which the reader reads once (`_latest_per_job`)."""
+        leaves rows twice, which the reader reads once (`part_files.latest_per_job`)."""
         merged = 0
         for kind in ("results", "failures"):
             for folder in sorted((self.root / kind).glob("campaign=*")):
@@ -170,7 +172,7 @@ class ResultStore:
     def _merge(self, kind: str, campaign_folder: str, parts: list[Path]) -> None:
         """Write the rows of `parts` as one compacted file of ``kind``, then remove them."""
         table = self._dataset(kind, parts).to_table()
-        _write_file(self.root / "compact" / kind / campaign_folder, table.sort_by("actuator"))
+        write_file(self.root / "compact" / kind / campaign_folder, table.sort_by("actuator"))
         for part in parts:
             part.unlink(missing_ok=True)
             with contextlib.suppress(OSError):  # a folder a concurrent write still fills stays
@@ -214,10 +216,11 @@ class ResultStore:
         campaign: str | None = None,
         columns: Iterable[str] | None = None,
         actuator: str | None = None,
+        actuators: Sequence[str] | None = None,
     ) -> Any:
         """The ``kind`` dataset as a pyarrow Table (empty if nothing was written), optionally of
-        one campaign (and `actuator`) and some columns; one row per job key for results (its
-        latest); `InputError` naming a part file that cannot be read."""
+        one campaign (and `actuator`, or `actuators`) and some columns; one row per job key for
+        results (its latest); `InputError` naming a part file that cannot be read."""
         pa, ds, _ = _pyarrow()
         base = RESULT_COLUMNS if kind == "results" else FAILURE_COLUMNS
         names = list(columns) if columns is not None else [*PARTITIONS, *base]
@@ -232,12 +235,38 @@ class ResultStore:
                 if value is not None:
                     term = ds.field(name) == value
                     filt = term if filt is None else filt & term
+            if actuators is not None:  # partitions pruned: only these actuators' folders are read
+                term = ds.field("actuator").isin(list(actuators))
+                filt = term if filt is None else filt & term
             table = data.to_table(columns=[*names, *extra], filter=filt)
         except (pa.ArrowInvalid, OSError) as exc:
             raise InputError(
                 f"{self.root / kind}: a part file cannot be read ({exc})".splitlines()[0]
             ) from None
-        return _latest_per_job(table).drop_columns(extra) if kind == "results" else table.drop_columns(extra)
+        return latest_per_job(table).drop_columns(extra) if kind == "results" else table.drop_columns(extra)
+
+    def actuators(self, campaign: str | None = None) -> list[str]:
+        """The ids of the actuators with results (of `campaign`), sorted: their folders' names and
+        the compacted files' actuator column (no result row is read)."""
+        pa, ds, _ = _pyarrow()
+        import pyarrow.compute as pc
+
+        ids = {
+            d.name.removeprefix("actuator=")
+            for d in (self.root / "results").glob(f"campaign={campaign or '*'}/actuator=*")
+        }
+        compacted = self.root / "compact" / "results"
+        if compacted.is_dir():
+            data = ds.dataset(
+                compacted,
+                format="parquet",
+                schema=pa.schema([("campaign", pa.string()), ("actuator", pa.string())]),
+            )
+            filt = None if campaign is None else ds.field("campaign") == campaign
+            ids.update(
+                pc.unique(data.to_table(columns=["actuator"], filter=filt).column("actuator")).to_pylist()
+            )
+        return sorted(ids)
 
     def fingerprints(self, campaign: str | None = None) -> dict[str, str | None]:
         """The fingerprint of each stored job's latest result row (None: a row made before them)."""
@@ -250,39 +279,3 @@ class ResultStore:
         """The job keys stored in ``kind`` (of one campaign)."""
         table = self.read(kind, campaign, columns=["job_key"])
         return {str(k) for k in table.column("job_key").to_pylist()}
-
-
-def _latest_per_job(table: Any) -> Any:
-    """One row per job key: the one finished last (a job redone for another fingerprint, or a row
-    written twice by a retried flush, is read once: review M2, H1)."""
-    import pyarrow.compute as pc
-
-    if pc.count_distinct(table.column("job_key")).as_py() == table.num_rows:
-        return table
-    keys, finished = table.column("job_key").to_pylist(), table.column("finished").to_pylist()
-    latest: dict[str, int] = {}
-    for i, (key, when) in enumerate(zip(keys, finished, strict=True)):
-        j = latest.get(key)
-        if j is None or (when or "") >= (finished[j] or ""):
-            latest[key] = i
-    if len(latest) == len(keys):
-        return table
-    return table.take(sorted(latest.values()))
-
-
-def _write_file(folder: Path, table: Any) -> Path:
-    """Write `table` as a new part file in `folder` (made if new): whole under a hidden temporary
-    name, flushed to disk, then renamed into place."""
-    _, _, pq = _pyarrow()
-    folder.mkdir(parents=True, exist_ok=True)
-    name = f"part-{uuid.uuid4().hex}.parquet"
-    tmp = folder / f".{name}.tmp"
-    try:
-        with tmp.open("wb") as fh:
-            pq.write_table(table, fh, row_group_size=8192)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, folder / name)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return folder / name

@@ -94,16 +94,16 @@ def fleet_report(
 
     if not inspection_interval > 0:
         raise InputError(f"the inspection interval must be > 0 flights, got {inspection_interval}")
-    table = ResultStore(store).read("results", campaign, columns=COLUMNS)
-    if table.num_rows == 0:
-        raise InputError(f"{store}: no results" + (f" of campaign {campaign!r}" if campaign else ""))
     if unit not in UNITS:
         raise InputError(f"unknown unit {unit!r}; use one of {', '.join(UNITS)}")
-    options = {"thresholds": thresholds, "interval": inspection_interval, "seed": seed, "unit": unit,
-               "include_doubtful": include_doubtful, "usage": read_usage(store, campaign),
-               "charts": charts}  # fmt: skip
-    entries = _ranked_parts(table, options, progress)
-    entries.sort(key=_urgency)
+    ids = ResultStore(store).actuators(campaign)
+    if not ids:
+        raise InputError(f"{store}: no results" + (f" of campaign {campaign!r}" if campaign else ""))
+    options = {"store": str(store), "campaign": campaign, "thresholds": thresholds, "interval": inspection_interval,
+               "seed": seed, "unit": unit, "include_doubtful": include_doubtful, "usage": read_usage(store, campaign),
+               # every chart for a small fleet, the ones not green for a large one
+               "charts": None if not charts else "all" if len(ids) <= ALL_CHARTS else "urgent"}  # fmt: skip
+    entries = _ranked_parts(ids, options, progress)
     counts = {c: sum(e["colour"] == c for e in entries) for c in COLOURS}
     counts.update({v: sum(e["verdict"] == v for e in entries) for v in ("doubtful", "does not fit")})
     return {
@@ -115,35 +115,42 @@ def fleet_report(
 
 
 def _ranked_parts(
-    table: Any, options: dict[str, Any], progress: Callable[[int, int], None] | None
+    ids: list[str], options: dict[str, Any], progress: Callable[[int, int], None] | None
 ) -> list[Any]:
-    """The entries of every actuator of `table`, ranked; a large fleet's second half in a second
-    process (`PARALLEL_FROM` actuators or more, and more than one core)."""
-    table = table.sort_by([(c, "ascending") for c in ("campaign", "actuator", "flight", "finished", "seed")])
-    bounds = _groups(table)
-    if options["charts"]:  # every chart for a small fleet, the ones not green for a large one
-        options = {**options, "charts": "all" if len(bounds) <= ALL_CHARTS else "urgent"}
-    entries: list[dict[str, Any]] = []
-    if len(bounds) >= PARALLEL_FROM and _cores() > 1:
+    """The entries of the actuators `ids`, ranked; a large fleet's second half read and computed
+    in a second process (`PARALLEL_FROM` actuators or more, and more than one core)."""
+    if len(ids) >= PARALLEL_FROM and _cores() > 1:
         import concurrent.futures
         import multiprocessing
 
-        half = len(bounds) // 2
-        start = bounds[half][0]
-        other = _ipc(table.slice(start))
+        half = len(ids) // 2
         with concurrent.futures.ProcessPoolExecutor(
             1, mp_context=multiprocessing.get_context("spawn")
         ) as pool:
-            future = pool.submit(_entries_of_ipc, other, options)
-            mine = bounds[:half]
-            entries = _entries(table.slice(0, start), mine, options, progress, scale=len(bounds) / len(mine))
+            future = pool.submit(_entries_of, ids[half:], options, None)
+            entries = _entries_of(ids[:half], options, progress, scale=len(ids) / half)
             entries += future.result()
     else:
-        entries = _entries(table, bounds, options, progress)
+        entries = _entries_of(None, options, progress)
     if progress is not None:
-        progress(len(bounds), len(bounds))
+        progress(len(ids), len(ids))
     entries.sort(key=_urgency)
     return entries
+
+
+def _entries_of(
+    ids: list[str] | None,
+    options: dict[str, Any],
+    progress: Callable[[int, int], None] | None,
+    scale: float = 1.0,
+) -> list[dict[str, Any]]:
+    """The entries of the actuators `ids` (None: all) of the store, read here (each process reads
+    its own half of a large fleet: no table crosses between them)."""
+    from ..campaign.store import ResultStore
+
+    table = ResultStore(options["store"]).read("results", options["campaign"], columns=COLUMNS, actuators=ids)
+    table = table.sort_by([(c, "ascending") for c in ("campaign", "actuator", "flight", "finished", "seed")])
+    return _entries(table, _groups(table), options, progress, scale)
 
 
 ALL_CHARTS = 1000  # actuators up to which every one's chart data is made (above: the ones not green)
@@ -163,23 +170,6 @@ def _groups(table: Any) -> list[tuple[int, int]]:
             bounds.append((start, i - start))
             start = i
     return bounds
-
-
-def _ipc(table: Any) -> bytes:
-    import pyarrow as pa
-
-    sink = pa.BufferOutputStream()
-    with pa.ipc.new_stream(sink, table.schema) as writer:
-        writer.write_table(table)
-    return bytes(sink.getvalue())
-
-
-def _entries_of_ipc(data: bytes, options: dict[str, Any]) -> list[dict[str, Any]]:
-    """`_entries` of a table sent as Arrow IPC bytes (the second process's half)."""
-    import pyarrow as pa
-
-    table = pa.ipc.open_stream(data).read_all()
-    return _entries(table, _groups(table), options, None)
 
 
 def _entries(

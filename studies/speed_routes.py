@@ -1,0 +1,51 @@
+"""Issue 36, first look: what the identification's stages cost and what dropping each does to accuracy.
+
+    python studies/speed_routes.py ROUTE [bench_multifault options ...]
+
+Runs `benchmarks/bench_multifault.py` (its cases, seeds and figures: %err median / p90 / max, wrong
+basins, wall time per identification) with one route of issue 36 applied in this process:
+
+- ``default``: today's pipeline (GA search, the CMA-ES polish of the best point and its runner-up,
+  the least-squares polish, the switching last stage);
+- ``no-cmaes``: the CMA-ES polish skipped (`polish.polish_two` returns its start), the least-squares
+  polish kept: the profile's 43 % of the CPU;
+- ``small-cmaes``: the CMA-ES polish of the best point only, budget (16, 20).
+
+Example: ``python studies/speed_routes.py no-cmaes --cases 20 --seeds 2 --restarts 0``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+ROUTES = ("default", "no-cmaes", "small-cmaes")
+
+
+def apply(route: str) -> None:
+    from emaphm.identification import limits, polish
+
+    if route == "no-cmaes":
+        polish.polish_two = lambda evaluate, run, **kw: (run, False)  # type: ignore[assignment]
+    elif route == "small-cmaes":
+        limits.POLISH_BUDGET = (16, 20)  # type: ignore[misc]
+        polish.polish_two = lambda evaluate, run, **kw: (polish.polish(evaluate, run, seed=kw.get("seed", 0)), False)  # type: ignore[assignment]
+    elif route != "default":
+        raise SystemExit(f"unknown route {route!r}; one of {', '.join(ROUTES)}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = sys.argv[1:] if argv is None else argv
+    if not args or args[0] in ("-h", "--help"):
+        print(__doc__)
+        return
+    apply(args[0])
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    import bench_multifault
+
+    print(f"route: {args[0]}")
+    bench_multifault.main(args[1:])
+
+
+if __name__ == "__main__":
+    main()
