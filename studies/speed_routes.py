@@ -11,7 +11,8 @@ basins, wall time per identification) with one route of issue 36 applied in this
   polish kept: the profile's 43 % of the CPU;
 - ``small-cmaes``: the CMA-ES polish of the best point only, budget (16, 20).
 
-Example: ``python studies/speed_routes.py no-cmaes --cases 20 --seeds 2 --restarts 0``.
+Example: ``python studies/speed_routes.py no-cmaes --cases 20 --seeds 2 --restarts 0``. Figures
+(BENCHMARKS.md, "Issue 36, first measurements") at 635ecde.
 """
 
 from __future__ import annotations
@@ -35,16 +36,18 @@ def apply(route: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = sys.argv[1:] if argv is None else argv
-    if not args or args[0] in ("-h", "--help"):
-        print(__doc__)
-        return
-    apply(args[0])
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     epilog="Other options go to benchmarks/bench_multifault.py.")  # fmt: skip
+    parser.add_argument("route", choices=ROUTES)
+    args, rest = parser.parse_known_args(argv)
+    apply(args.route)
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
     import bench_multifault
 
-    print(f"route: {args[0]}")
-    bench_multifault.main(args[1:])
+    print(f"route: {args.route}")
+    bench_multifault.main(rest)
 
 
 if __name__ == "__main__":

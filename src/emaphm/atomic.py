@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["atomic_path"]
+__all__ = ["atomic_path", "replace_folder"]
 
 _TMP_TAG = "emaphm"
 
@@ -87,3 +87,17 @@ def atomic_path(target: Path) -> Iterator[Path]:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def replace_folder(new: Path, target: Path) -> None:
+    """Put the complete folder `new` (a sibling of `target`, on its file system) at `target`,
+    replacing an older one whole: a reader sees the old folder or the new, never a mix."""
+    import shutil
+
+    if target.exists():
+        old = target.with_name(f".{target.name}-old-{os.getpid()}")
+        os.replace(target, old)
+        os.replace(new, target)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(new, target)

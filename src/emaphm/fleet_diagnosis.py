@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import html
 import json
-import os
 import shutil
 import tempfile
 from pathlib import Path
 from typing import Any
+
+from .atomic import replace_folder
 
 __all__ = ["diagnosis_page", "write_diagnosis_pages"]
 
@@ -110,11 +111,7 @@ def write_diagnosis_pages(report: dict[str, Any], folder: Path, params: Any = No
             page = diagnosis_page(entry, entry["_latest"], units, failure, nominal=params is None)
             (tmp / name).write_text(page, encoding="utf-8")
             entry["report"] = f"actuators/{name}"
-        old = folder / f".actuators-old-{os.getpid()}"
-        if target.exists():
-            os.replace(target, old)
-        os.replace(tmp, target)
-        shutil.rmtree(old, ignore_errors=True)
+        replace_folder(tmp, target)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return len(entries)

@@ -20,7 +20,6 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
-import shutil
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -28,6 +27,7 @@ from typing import Any
 from .._version import __version__
 from .._versions import versions
 from ..actuator import params_template
+from ..atomic import replace_folder
 from ..calibration.files import params_hash
 from ..errors import InputError
 from ..identification.detection import load_thresholds
@@ -124,13 +124,7 @@ def write_baseline(
         from .report import write_report
 
         write_report(made, tmp)
-        if out.exists():
-            old = out.with_name(f".{out.name}-old-{os.getpid()}")
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out)
+        replace_folder(tmp, out)
     return out
 
 

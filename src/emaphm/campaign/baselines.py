@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from ..atomic import replace_folder
 from ..io import sha256_of
 from .fingerprint import code_hash
 
@@ -120,13 +121,7 @@ def install(made: dict[str, Any]) -> Path:
         (tmp / RECORD).write_text(json.dumps({"key": job["key"], "campaign": job["campaign"],
                                               "actuator": job["actuator"], "recordings": job["recordings"],
                                               "wall_time_s": made["wall_time_s"]}, indent=2) + "\n")  # fmt: skip
-        if folder.exists():
-            old = folder.with_name(f".{folder.name}-old-{os.getpid()}")
-            os.replace(folder, old)
-            os.replace(tmp, folder)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, folder)
+        replace_folder(tmp, folder)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return folder

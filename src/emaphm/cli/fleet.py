@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import InputError
+from .options import UnitOption
 from .output import err
 
 __all__ = ["fleet"]
@@ -33,13 +34,7 @@ def fleet(
     inspection_interval: Annotated[
         float, typer.Option(help="Flights (or --unit) to the next inspection: the colours are shares of it.")
     ] = 10.0,
-    unit: Annotated[
-        str,
-        typer.Option(
-            help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
-            "cycles from the campaign's usage per flight)."
-        ),
-    ] = "flights",
+    unit: UnitOption = "flights",
     include_doubtful: Annotated[
         bool,
         typer.Option("--include-doubtful", help='Track the diagnoses with verdict "doubtful" too.'),

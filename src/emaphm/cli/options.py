@@ -24,6 +24,7 @@ __all__ = [
     "OptimizerOption",
     "ParamsNeedCalibrationOption",
     "ParamsOption",
+    "UnitOption",
     "WorkersOption",
     "settings_from_options",
     "with_settings_options",
@@ -46,6 +47,13 @@ ParamsNeedCalibrationOption = Annotated[
 ]
 OptimizerOption = Annotated[str, typer.Option(help=f"{', '.join(OPTIMIZERS[:-1])} or {OPTIMIZERS[-1]}.")]
 WorkersOption = Annotated[int, typer.Option(help="Threads for the population kernel (0: all cores).")]
+UnitOption = Annotated[
+    str,
+    typer.Option(
+        help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
+        "cycles from the campaign's usage per flight)."
+    ),
+]  # emaphm rul, emaphm fleet
 
 
 # the CLI type of each `IdentifySettings` field type (the error corner is text: "auto", "off" or Hz)

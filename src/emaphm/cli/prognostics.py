@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import InputError
+from .options import UnitOption
 from .output import err
 from .render import print_rul
 
@@ -38,13 +39,7 @@ def rul(
     inspection_interval: Annotated[
         float, typer.Option(help="Flights to the next inspection, for the probability of failing before it.")
     ] = 10.0,
-    unit: Annotated[
-        str,
-        typer.Option(
-            help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
-            "cycles from the campaign's usage per flight)."
-        ),
-    ] = "flights",
+    unit: UnitOption = "flights",
     estimator: Annotated[
         str,
         typer.Option(
