@@ -118,3 +118,15 @@ def test_an_interval_in_hours_is_that_many_flights_at_the_actuators_rate(tmp_pat
     assert by_hours["actuators"][0]["remaining_share"] == by_flights["actuators"][0]["remaining_share"]
     code, out, _ = run_cli(["rul", str(tmp_path), "--actuator", "H", "--unit", "hours"], capsys)
     assert code == 0 and "due:" in out and "hours at 5 %" in out
+
+
+def test_a_one_off_measurement_needs_no_usage_but_a_history_does(tmp_path):
+    store = ResultStore(tmp_path)
+    one_off = _rows("ONE", [0])
+    store.write("results", one_off + _rows("H", range(1, 4)))
+    store.write_usage("u", [{"campaign": "u", "actuator": "H", "flight": f, "hours": 1.0 * f} for f in range(1, 4)])
+    by = {e["actuator"]: e for e in fleet_report(tmp_path, unit="hours")["actuators"]}
+    assert by["ONE"]["due"] is None and by["H"]["due"]["unit"] == "hours"
+    store.write("results", _rows("H2", range(1, 3)))
+    with pytest.raises(InputError, match="'H2' has no hours recorded"):
+        fleet_report(tmp_path, unit="hours")

@@ -84,7 +84,8 @@ def entry(
     worst = max(faults, key=lambda n: faults[n]["share"]) if faults else None
     share = faults[worst]["share"] if worst is not None else None
     rate = rates(usage, float(latest["flight"]))
-    interval = interval_in_flights(options["interval"], options["unit"], rate, actuator)
+    history = any(r["flight"] >= 1 for r in rows)  # a one-off measurement has no RUL to convert
+    interval = interval_in_flights(options["interval"], options["unit"], rate, actuator) if history else options["interval"]
     first, left_out, series = _rul(actuator, rows, limits, interval, options)
     p05 = first.get("rul_p05")
     if first.get("status") == "tracked":
