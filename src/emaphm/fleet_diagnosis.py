@@ -5,8 +5,9 @@ its currents: this page is the diagnosis report without its figures (`report_pag
 one, from ``emaphm identify --report``). The verdict first, each reason of a "doubtful" one, the
 faults in physical units with their 90 % intervals and the detection and failure thresholds
 (`tables.physical_rows`; no fault values for "does not fit"), then the recording, the settings and
-the store row it came from. Written for each actuator that has a chart on the fleet page, into
-``DIR/actuators/<id>.html``, linked from its row (``report``).
+the store row it came from. Written for the `FIRST_PAGES` most urgent actuators that have a chart on
+the fleet page and every red one, into ``DIR/actuators/<campaign>--<id>.html``, linked from its row
+(``report``).
 """
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ from typing import Any
 
 from .atomic import replace_folder
 
-__all__ = ["diagnosis_page", "write_diagnosis_pages"]
+__all__ = ["FIRST_PAGES", "diagnosis_page", "write_diagnosis_pages"]
+
+FIRST_PAGES = 1000  # the most urgent actuators with a page (and every red one beyond)
 
 _STYLE = (
     "body{font-family:system-ui,sans-serif;margin:1.5em;max-width:70em;color:#222}"
@@ -101,7 +104,8 @@ def write_diagnosis_pages(report: dict[str, Any], folder: Path, params: Any = No
 
     if failure is None:  # the thresholds the fleet was ranked by (placeholders where none was given)
         failure = {n: t["threshold"] for n, t in (report.get("thresholds") or {}).items()}
-    entries = [e for e in report["actuators"] if e.get("_latest") is not None]
+    entries = [e for i, e in enumerate(report["actuators"])  # the most urgent, and every red one
+               if e.get("_latest") is not None and (i < FIRST_PAGES or e.get("colour") == "red")]  # fmt: skip
     target = folder / "actuators"
     tmp = Path(tempfile.mkdtemp(dir=folder, prefix=".actuators-"))
     try:
