@@ -25,13 +25,13 @@ def print_fleet(data: dict[str, Any], top: int) -> None:
                         f"{data['inspection_interval']:g} {unit})")  # fmt: skip
     dues = any(e.get("due") for e in entries[:top])
     for column in ("", "actuator", "verdict", "worst fault", "of threshold", "RUL 5 / 50 / 95 % (flights)",
-                   *(("due",) if dues else ()), "P(fail before next)", "why"):  # fmt: skip
+                   *(("due at 5 %",) if dues else ()), "P(fail before next)", "why"):  # fmt: skip
         table.add_column(column, justify="right" if column.startswith(("of", "RUL", "P(")) else "left")
     for e in entries[:top]:
         rul = " / ".join(_num(e[k]) for k in ("rul_p05", "rul_median", "rul_p95"))
         table.add_row(
             f"[{STYLE[e['colour']]}]{e['colour']}[/]", e["actuator"], e["verdict"], e["worst_fault"] or "-",
-            _num(e["threshold_share"], "{:.0%}"), rul, *((due_text(e["due"]) if e.get("due") else "-",) if dues else ()),
+            _num(e["threshold_share"], "{:.0%}"), rul, *((_due_short(e.get("due")),) if dues else ()),
             _num(e["prob_fail_before_next_inspection"], "{:.2f}"), e["reason"],
         )  # fmt: skip
     out = stdout_console()
@@ -51,6 +51,15 @@ def print_fleet(data: dict[str, Any], top: int) -> None:
             "failure thresholds are placeholders (not airworthiness limits) where no actuator file gives them: "
             "pass --params FILE or --threshold FAULT=DISTANCE"
         )
+
+
+def _due_short(due: dict[str, Any] | None) -> str:
+    """The 5 % RUL in hours or cycles and its date, for a table cell."""
+    if not due:
+        return "-"
+    amount = f"{due['rul_p05']:.0f} {due['unit']}" if due.get("unit") and due.get("rul_p05") is not None else ""
+    date = due.get("date_p05") or ""
+    return " ".join(p for p in (amount, f"({date})" if amount and date else date) if p) or "beyond"
 
 
 def due_text(due: dict[str, Any]) -> str:
