@@ -9,7 +9,8 @@ basins, wall time per identification) with one route of issue 36 applied in this
   the least-squares polish, the switching last stage);
 - ``no-cmaes``: the CMA-ES polish skipped (`polish.polish_two` returns its start), the least-squares
   polish kept: the profile's 43 % of the CPU;
-- ``small-cmaes``: the CMA-ES polish of the best point only, budget (16, 20).
+- ``small-cmaes``: the CMA-ES polish of the best point only, budget (16, 20);
+- ``small-two``: the CMA-ES polish of the best point and its runner-up, budget (16, 20) each.
 
 Example: ``python studies/speed_routes.py no-cmaes --cases 20 --seeds 2 --restarts 0``. Figures
 (BENCHMARKS.md, "Issue 36, first measurements") at 635ecde.
@@ -20,7 +21,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROUTES = ("default", "no-cmaes", "small-cmaes")
+ROUTES = ("default", "no-cmaes", "small-cmaes", "small-two")
 
 
 def apply(route: str) -> None:
@@ -31,6 +32,8 @@ def apply(route: str) -> None:
     elif route == "small-cmaes":
         limits.POLISH_BUDGET = (16, 20)  # type: ignore[misc]
         polish.polish_two = lambda evaluate, run, **kw: (polish.polish(evaluate, run, seed=kw.get("seed", 0)), False)  # type: ignore[assignment]
+    elif route == "small-two":
+        limits.POLISH_BUDGET = (16, 20)  # type: ignore[misc]
     elif route != "default":
         raise SystemExit(f"unknown route {route!r}; one of {', '.join(ROUTES)}")
 
