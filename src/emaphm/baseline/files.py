@@ -163,6 +163,7 @@ def _actuator_text(made: Baseline, created: str) -> str:
     lines += [f"#   recording {r['file']} (sha256 {r['sha256'][:16]}...): fit NRMSE {100 * r['fit_nrmse']:.2f} %"
               for r in made.record["recordings"]]  # fmt: skip
     lines.append(
-        "# R_s, L_s and the drive stay the nameplate's: under current control the recordings do not tell them"
+        "# R_s, L_s, the healthy free play B0 and the drive stay the nameplate's: under current control the "
+        "recordings do not tell R_s and L_s, and a fitted B0 moved every backlash estimate (docs/your-actuator.md §0)"
     )
     return "\n".join(lines) + "\n" + params_template(made.params)

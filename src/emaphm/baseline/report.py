@@ -66,7 +66,7 @@ def write_report(made: Baseline, directory: Path) -> Path:
         "<style>body{font-family:system-ui,sans-serif;max-width:980px;margin:2em auto}table{border-collapse:collapse}"
         "td,th{border:1px solid #ccc;padding:.25em .6em}img{max-width:100%}</style></head><body>"
         "<h1>emaphm baseline</h1><p>The constants of this actuator fitted to recordings of it when healthy, "
-        "about its nameplate (R_s, L_s and the drive stay the nameplate's).</p>"
+        "about its nameplate (R_s, L_s, the healthy free play B0 and the drive stay the nameplate's).</p>"
         "<table><tr><th>constant</th><th>nameplate</th><th>this actuator</th><th>change</th>"
         "<th>90 % interval (× nameplate)</th></tr>" + "".join(rows) + "</table>"
         "<h2>Recordings</h2><table><tr><th>file</th><th>SHA-256</th><th>fit at the nameplate</th>"
