@@ -107,7 +107,7 @@ def test_the_bands():
 def test_two_processes_give_what_one_gives(store, monkeypatch):
     one = fleet_report(store, seed=5)
     monkeypatch.setattr(fleet_module, "PARALLEL_FROM", 10)
-    monkeypatch.setattr(fleet_module, "_cores", lambda: 2)
+    monkeypatch.setattr(fleet_module, "usable_cores", lambda: 2)
     two = fleet_report(store, seed=5)
     strip = lambda r: [{k: v for k, v in e.items()} for e in r["actuators"]]  # noqa: E731
     assert strip(one) == strip(two)

@@ -52,3 +52,10 @@ def thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R
         return [fn(item) for item in items]
     with ThreadPoolExecutor(threads) as pool:
         return list(pool.map(fn, items))
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its affinity where the OS tells it, else the count)."""
+    import os
+
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1

@@ -10,7 +10,7 @@ import pytest
 
 from emaphm.campaign import ResultStore, load_campaign, run_campaign
 from emaphm.campaign.store import RESULT_COLUMNS
-from emaphm.campaign.usage import flight_usage, parse_usage
+from emaphm.campaign.usage import flight_usages, parse_usage
 from emaphm.errors import InputError
 from emaphm.prognostics.fleet import fleet_report
 from emaphm.prognostics.rul import rul_report
@@ -37,12 +37,12 @@ growth = [0.01, 0.004, 0, 0, 0, 0, 0, 0]
 
 def test_usage_per_flight_or_at_each_flight():
     rate = parse_usage({"hours": 2.5, "cycles": [1, 3, 4], "first_date": dt.date(2026, 1, 5), "days": 3}, "x")
-    assert flight_usage(rate, 2, 3, "x") == {"hours": 5.0, "cycles": 3.0, "date": "2026-01-08"}
-    assert flight_usage(rate, 0, 3, "x") is None  # a one-off measurement has no flight
+    assert flight_usages(rate, [1, 2, 3], "x")[1] == {"hours": 5.0, "cycles": 3.0, "date": "2026-01-08"}
+    assert flight_usages(rate, [0, 1, 2, 3], "x")[0] is None  # a one-off measurement has no flight
     listed = parse_usage({"dates": ["2026-02-01", dt.date(2026, 2, 9)]}, "x")
-    assert flight_usage(listed, 2, 2, "x")["date"] == "2026-02-09"
+    assert flight_usages(listed, [1, 2], "x")[1]["date"] == "2026-02-09"
     with pytest.raises(InputError, match="2 values for 3 flights"):
-        flight_usage(listed, 1, 3, "x")
+        flight_usages(listed, [1, 2, 3], "x")
 
 
 @pytest.mark.parametrize(

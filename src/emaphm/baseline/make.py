@@ -43,12 +43,13 @@ Progress = Callable[[str, int, int], None]
 
 
 class Baseline:
-    """A baseline made (`make_baseline`): the fitted actuator and calibration, and the record."""
+    """A baseline made (`make_baseline`): the fitted actuator and calibration, the record, and each
+    recording's context and monitor current at the baseline's constants (`currents`, for the report)."""
 
     def __init__(self, params: Any, calibration: Calibration, fit: BaselineFit, record: dict[str, Any],
-                 nameplate: Any, contexts: list[Any]) -> None:  # fmt: skip
+                 nameplate: Any, contexts: list[Any], currents: list[Any]) -> None:  # fmt: skip
         self.params, self.calibration, self.fit, self.record = params, calibration, fit, record
-        self.nameplate, self.contexts = nameplate, contexts
+        self.nameplate, self.contexts, self.currents = nameplate, contexts, currents
 
 
 def make_baseline(
@@ -91,7 +92,8 @@ def make_baseline(
     )
     _check_one_healthy_actuator([str(r) for r in recordings], fit, alone)
     fitted, cal = apply(nameplate, monitor.calibration, fit.factors)
-    fit = replace(fit, fit_nrmse=_fits(contexts, fitted, cal, fit.factors["i_gain"]))
+    currents = _currents(contexts, fitted, cal, fit.factors["i_gain"])
+    fit = replace(fit, fit_nrmse=[_nrmse(ctx, i) for ctx, i in zip(contexts, currents, strict=True)])
     record = {
         "recordings": [{"file": str(r), "sha256": sha256_of(r), "fit_nrmse": round(f, 6),
                         "nameplate_fit_nrmse": round(s, 6)} for r, f, s in zip(recordings, fit.fit_nrmse, fit.start_nrmse, strict=True)],
@@ -103,7 +105,7 @@ def make_baseline(
         "fit": fit.details,
         "wall_time_s": round(time.perf_counter() - start, 2),
     }  # fmt: skip
-    return Baseline(fitted, cal, fit, record, nameplate, contexts)
+    return Baseline(fitted, cal, fit, record, nameplate, contexts, currents)
 
 
 def _monitor(nameplate: Any, calibration: Any) -> tuple[MonitorEma, str | None]:
@@ -139,19 +141,24 @@ def _twin_contexts(contexts: list[Any], nameplate: Any, monitor: MonitorEma, set
     return out
 
 
-def _fits(contexts: list[Any], params: Any, calibration: Calibration, gain: float) -> list[float]:
-    """Each recording's NRMSE with the monitor at the baseline's constants, healthy, through the
-    sensor's `gain`."""
+def _currents(contexts: list[Any], params: Any, calibration: Calibration, gain: float) -> list[Any]:
+    """Each recording's monitor current at the baseline's constants, healthy, filtered as the
+    recording is and through the sensor's `gain`: one simulation each, for the fits and the report."""
     from ..faults import HEALTHY
-    from ..identification.signals import nrmse
 
     out = []
     for ctx in contexts:
         model = MonitorEma(params, ctx.monitor.command, calibration, allow_mismatch=True)
-        fitted = gain * ctx.reference.filtered(model.simulate(HEALTHY, duration=ctx.duration).i_q)
-        keep = ctx.mask > 0
-        out.append(float(nrmse(ctx.reference.reference[keep], fitted[keep])))
+        out.append(gain * ctx.reference.filtered(model.simulate(HEALTHY, duration=ctx.duration).i_q))
     return out
+
+
+def _nrmse(ctx: Any, current: Any) -> float:
+    """A recording's NRMSE against `current` over its compared samples."""
+    from ..identification.signals import nrmse
+
+    keep = ctx.mask > 0
+    return float(nrmse(ctx.reference.reference[keep], current[keep]))
 
 
 def _factor_record(fit: BaselineFit, name: str) -> dict[str, float]:

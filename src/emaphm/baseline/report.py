@@ -10,8 +10,6 @@ import base64
 import html
 from pathlib import Path
 
-from ..faults import HEALTHY
-from ..models import MonitorEma
 from .fit import CONSTANTS
 from .make import Baseline
 
@@ -34,11 +32,7 @@ def write_report(made: Baseline, directory: Path) -> Path:
 
     e = html.escape
     figures = []
-    for i, ctx in enumerate(made.contexts, start=1):
-        model = MonitorEma(made.params, ctx.monitor.command, made.calibration, allow_mismatch=True)
-        fitted = made.fit.factors["i_gain"] * ctx.reference.filtered(
-            model.simulate(HEALTHY, duration=ctx.duration).i_q
-        )
+    for i, (ctx, fitted) in enumerate(zip(made.contexts, made.currents, strict=True), start=1):
         nrmse = made.fit.fit_nrmse[i - 1]
         path = plot_fit_curves(ctx.curves(fitted), directory / f"fit-{i}.png",
                                f"recording {i}: NRMSE {100 * nrmse:.2f} % at the baseline's constants, healthy",

@@ -28,12 +28,14 @@ def latest_per_job(table: Any) -> Any:
     return table.take(sorted(latest.values()))
 
 
-def write_file(folder: Path, table: Any) -> Path:
-    """Write `table` as a new part file in `folder` (made if new): whole under a hidden temporary
-    name, flushed to disk, then renamed into place."""
+def write_file(folder: Path, table: Any, name: str | None = None) -> Path:
+    """Write `table` as the file `name` in `folder` (made if new; default a new part file's name),
+    whole under a hidden temporary name, flushed to disk, then renamed into place (replacing one of
+    that name)."""
     import pyarrow.parquet as pq
+
     folder.mkdir(parents=True, exist_ok=True)
-    name = f"part-{uuid.uuid4().hex}.parquet"
+    name = name or f"part-{uuid.uuid4().hex}.parquet"
     tmp = folder / f".{name}.tmp"
     try:
         with tmp.open("wb") as fh:

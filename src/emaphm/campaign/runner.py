@@ -27,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from .._threads import usable_cores
 from ..errors import InputError
 from .cluster import run_dask
 from .jobs import failure_line, failure_row, run_job
@@ -72,10 +73,6 @@ def _spec(spec: CampaignSpec | str | os.PathLike[str]) -> CampaignSpec:
     return spec if isinstance(spec, CampaignSpec) else load_campaign(spec)
 
 
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
 def run_campaign(
     spec: CampaignSpec | str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -95,11 +92,12 @@ def run_campaign(
     or kept with `keep_stale`; the latest row of a job is the one read."""
     spec = _spec(spec)
     store = ResultStore(out)
-    spec.jobs(out)  # reads every file it names: a missing one is refused before the work
+    jobs = spec.jobs(out)  # reads every file it names: a missing one is refused before the work
     address, cores, serial = _backend(scheduler, workers)
     store.remove_temporaries()
     baselined = make_baselines(spec, out, store, address, workers or cores, serial, progress)
-    jobs = spec.jobs(out)  # now with the baselines made
+    if baselined["made"]:
+        jobs = spec.jobs(out)  # the actuators whose baseline this run made have their jobs now
     store.write_usage(spec.name, [{"campaign": spec.name, "actuator": j.actuator, "flight": j.flight, **j.usage}
                                   for j in jobs if j.usage and j.seed == spec.seeds[0]])  # fmt: skip
     stored = store.fingerprints(spec.name)
@@ -127,7 +125,7 @@ def run_campaign(
         failures=tuple(baselined["lines"]) + tuple(collector.lines),
         wall_time_s=round(time.perf_counter() - start, 3),
         backend=backend, workers=n_workers, startup_s=round(ready["at"] - start, 3),
-        baselines=baselined["made"], waiting=tuple(spec.waiting(out)),
+        baselines=baselined["made"], waiting=tuple(baselined["waiting"]),
     )  # fmt: skip
 
 
@@ -135,7 +133,7 @@ def _backend(scheduler: str | None, workers: int | None) -> tuple[str | None, in
     """The scheduler's address (None: a local cluster), this machine's cores, and whether the
     jobs run in this process; `InputError` for a worker count the machine lacks, or no Dask."""
     address = scheduler if scheduler is not None else os.environ.get("DASK_SCHEDULER_ADDRESS") or None
-    cores = _cores()
+    cores = usable_cores()
     if workers is not None and not 1 <= workers <= cores and address is None:
         raise InputError(
             f"--workers must be 1..{cores} on this machine (one numba thread each), got {workers}"
@@ -222,17 +220,18 @@ def make_baselines(
 ) -> dict[str, Any]:
     """Make the baselines of `spec` that the store lacks (`baselines`), each installed as it
     finishes (`progress` after each); a refused one is a failure row. How many were made and
-    failed, a line per failure."""
+    failed, a line per failure, and the actuators still waiting for theirs."""
     from .baselines import baseline_jobs, install, run_baseline
 
     todo = [b for b in baseline_jobs(spec, out) if not b.made()]
-    counts: dict[str, Any] = {"made": 0, "failed": 0, "lines": []}
+    counts: dict[str, Any] = {"made": 0, "failed": 0, "lines": [], "waiting": [b.actuator for b in todo]}
     start = time.perf_counter()
 
     def finished(made: dict[str, Any] | None, failure: dict[str, Any] | None) -> None:
         if made is not None:
             install(made)
             counts["made"] += 1
+            counts["waiting"].remove(made["job"]["actuator"])
         if failure is not None:
             store.write("failures", [failure])
             counts["failed"] += 1

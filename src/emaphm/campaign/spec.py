@@ -127,7 +127,7 @@ class Job:
     settings: dict[str, Any]
     key: str = ""
     fingerprint: str = ""
-    usage: dict[str, Any] | None = None  # hours, cycles, date of the flight (`usage.flight_usage`); not in the key
+    usage: dict[str, Any] | None = None  # hours, cycles, date of the flight (`usage.flight_usages`); not in the key
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -117,24 +117,14 @@ class ResultStore:
     def write_usage(self, campaign: str, rows: Sequence[dict[str, Any]]) -> Path | None:
         """Replace the usage of `campaign`'s flights (`USAGE_COLUMNS`, `campaign.usage`) by `rows`,
         atomically; none written (and an old one removed) when `rows` is empty."""
-        pa, _, pq = _pyarrow()
+        pa, _, _ = _pyarrow()
         target = self.root / "usage" / f"campaign={campaign}" / "usage.parquet"
         if not rows:
             target.unlink(missing_ok=True)
             return None
-        target.parent.mkdir(parents=True, exist_ok=True)
         schema = pa.schema([(n, getattr(pa, t)()) for n, t in USAGE_COLUMNS.items()])
         table = pa.Table.from_pylist([{c: r.get(c) for c in USAGE_COLUMNS} for r in rows], schema=schema)
-        tmp = target.parent / ".usage.parquet.tmp"
-        try:
-            with tmp.open("wb") as fh:
-                pq.write_table(table, fh)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, target)
-        finally:
-            tmp.unlink(missing_ok=True)
-        return target
+        return write_file(target.parent, table, target.name)
 
     def read_usage(self, campaign: str | None = None) -> Any:
         """The usage of the flights of every campaign (or one) as a pyarrow Table (empty: none given)."""

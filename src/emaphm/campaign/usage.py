@@ -23,7 +23,7 @@ from typing import Any
 
 from ..errors import InputError
 
-__all__ = ["USAGE_KEYS", "flight_usage", "flight_usages", "parse_usage"]
+__all__ = ["USAGE_KEYS", "flight_usages", "parse_usage"]
 
 USAGE_KEYS = {"hours", "cycles", "dates", "first_date", "days"}
 
@@ -91,11 +91,6 @@ def flight_usages(usage: dict[str, Any], flights: list[int], where: str) -> list
         if isinstance(value, list) and len(value) != n:
             raise InputError(f"{where}: usage {key} has {len(value)} values for {n} flights")
     return [None if f < 1 else _at(usage, f) for f in flights]
-
-
-def flight_usage(usage: dict[str, Any], flight: int, flights: int, where: str) -> dict[str, Any] | None:
-    """`flight_usages` of one flight of an actuator of `flights` flights."""
-    return flight_usages(usage, [*range(1, flights + 1), 0], where)[flight - 1 if flight >= 1 else -1]
 
 
 def _at(usage: dict[str, Any], flight: int) -> dict[str, Any]:

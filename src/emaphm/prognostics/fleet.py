@@ -31,6 +31,7 @@ import os
 from collections.abc import Callable
 from typing import Any
 
+from .._threads import usable_cores
 from ..errors import InputError
 from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS
 from .fleet_entry import BANDS, COLOURS, colour_of, entry, thresholds_of
@@ -47,7 +48,6 @@ CORE = [
 BOUNDS = [*(f"ci90_low_{k}" for k in K), *(f"ci90_high_{k}" for k in K)]  # the charts' whiskers
 LATEST = ["doubts", "fit_nrmse", "settings", "warnings", "reference", "reference_sha256", "job_key", "identify_seed",
           "version"]  # fmt: skip
-COLUMNS = [*CORE, *BOUNDS, *LATEST]
 
 
 def fleet_report(
@@ -119,7 +119,7 @@ def _ranked_parts(
 ) -> list[Any]:
     """The entries of the actuators `ids`, ranked; a large fleet's second half read and computed
     in a second process (`PARALLEL_FROM` actuators or more, and more than one core)."""
-    if len(ids) >= PARALLEL_FROM and _cores() > 1:
+    if len(ids) >= PARALLEL_FROM and usable_cores() > 1:
         import concurrent.futures
         import multiprocessing
 
@@ -148,17 +148,14 @@ def _entries_of(
     its own half of a large fleet: no table crosses between them)."""
     from ..campaign.store import ResultStore
 
-    table = ResultStore(options["store"]).read("results", options["campaign"], columns=COLUMNS, actuators=ids)
+    columns = CORE + LATEST + (BOUNDS if options["charts"] else [])  # the bounds draw the charts' whiskers
+    table = ResultStore(options["store"]).read("results", options["campaign"], columns=columns, actuators=ids)
     table = table.sort_by([(c, "ascending") for c in ("campaign", "actuator", "flight", "finished", "seed")])
     return _entries(table, _groups(table), options, progress, scale)
 
 
 ALL_CHARTS = 1000  # actuators up to which every one's chart data is made (above: the ones not green)
 PARALLEL_FROM = 2000  # actuators from which a second process computes half the fleet
-
-
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def _groups(table: Any) -> list[tuple[int, int]]:
@@ -183,31 +180,20 @@ def _entries(
     pool's threads spin beside the other process's: 8.4 s against 14.6 s for 10 000 actuators)."""
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(limits=1, user_api="blas"):
-        return _entries_here(table, bounds, options, progress, scale)
-
-
-def _entries_here(
-    table: Any,
-    bounds: list[tuple[int, int]],
-    options: dict[str, Any],
-    progress: Callable[[int, int], None] | None,
-    scale: float,
-) -> list[dict[str, Any]]:
     own: dict[str | None, dict[str, float]] = {}
     entries = []
     # the columns of every row, then the latest row's others: 200 000 rows x 55 columns as Python
     # objects cost seconds
-    core = table.select(CORE + (BOUNDS if options["charts"] else []))
-    rest = table.select(LATEST + ([] if options["charts"] else BOUNDS))
-    for i, (start, length) in enumerate(bounds):
-        rows = core.slice(start, length).to_pylist()
-        rows[-1].update(rest.slice(start + length - 1, 1).to_pylist()[0])
-        limits = thresholds_of(rows[-1], options["thresholds"], own)
-        key = (rows[0]["campaign"], rows[0]["actuator"])
-        entries.append(entry(key[0], key[1], rows, limits, options, options["usage"].get(key)))
-        if progress is not None and i % 500 == 0:
-            progress(int(i * scale), int(len(bounds) * scale))
+    core, rest = table.select(CORE + (BOUNDS if options["charts"] else [])), table.select(LATEST)
+    with threadpool_limits(limits=1, user_api="blas"):
+        for i, (start, length) in enumerate(bounds):
+            rows = core.slice(start, length).to_pylist()
+            rows[-1].update(rest.slice(start + length - 1, 1).to_pylist()[0])
+            limits = thresholds_of(rows[-1], options["thresholds"], own)
+            key = (rows[0]["campaign"], rows[0]["actuator"])
+            entries.append(entry(key[0], key[1], rows, limits, options, options["usage"].get(key)))
+            if progress is not None and i % 500 == 0:
+                progress(int(i * scale), int(len(bounds) * scale))
     return entries
 
 

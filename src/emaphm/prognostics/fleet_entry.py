@@ -10,19 +10,16 @@ from typing import Any
 
 from ..errors import InputError
 from ..failure import FAULTS, PLACEHOLDER_THRESHOLDS
-from .measurements import parsed
+from .fleet_series import series
+from .measurements import USED_VERDICTS, parsed
 from .rul import rul_of_rows
 from .usage import due, interval_in_flights, rates
 
 __all__ = ["BANDS", "COLOURS", "colour_of", "entry", "thresholds_of"]
 
 COLOURS = ("red", "orange", "yellow", "green")
-BANDS = (
-    0.0,
-    0.25,
-    0.5,
-)  # remaining share of the inspection interval: red <= 0 < orange <= 0.25 < yellow <= 0.5
-SIZES = ("fits", "doubtful")  # verdicts whose faults are sized
+# remaining share of the inspection interval: red <= 0 < orange <= 0.25 < yellow <= 0.5 < green
+BANDS = (0.0, 0.25, 0.5)
 
 
 def colour_of(remaining: float | None) -> str:
@@ -79,14 +76,14 @@ def entry(
     its failure thresholds, `options` the fleet's (interval, unit, seed, include_doubtful, charts),
     `usage` its flights' hours, cycles and dates (`usage.read_usage`)."""
     latest = rows[-1]
-    sizing = next((r for r in reversed(rows) if r.get("verdict") in SIZES), None)
+    sizing = next((r for r in reversed(rows) if r.get("verdict") in USED_VERDICTS), None)
     faults = _shares(sizing, limits) if sizing is not None else {}
     worst = max(faults, key=lambda n: faults[n]["share"]) if faults else None
     share = faults[worst]["share"] if worst is not None else None
     rate = rates(usage, float(latest["flight"]))
     history = any(r["flight"] >= 1 for r in rows)  # a one-off measurement has no RUL to convert
     interval = interval_in_flights(options["interval"], options["unit"], rate, actuator) if history else options["interval"]
-    first, left_out, series = _rul(actuator, rows, limits, interval, options)
+    first, left_out, make_series = _rul(actuator, rows, limits, interval, options)
     p05 = first.get("rul_p05")
     if first.get("status") == "tracked":
         remaining, basis = (None, "rul") if p05 is None else (p05 / interval, "rul")
@@ -113,7 +110,7 @@ def entry(
         "most_likely_fault": first.get("most_likely_fault"), "rul_status": first.get("status"),
         "remaining_share": None if remaining is None else round(remaining, 4), "remaining_basis": basis,
         "colour": colour, "reason": reason, "doubtful_left_out": left_out, "due": due(first, rate, options["unit"]),
-        "report": None, "_series": series() if wanted else (None if options["charts"] else {}),
+        "report": None, "_series": make_series() if wanted else (None if options["charts"] else {}),
         "_latest": latest if wanted else None,  # for its diagnosis page (`fleet_diagnosis`)
     }  # fmt: skip
 
@@ -136,13 +133,8 @@ def _rul(
                              seed=options["seed"], include_doubtful=options["include_doubtful"])  # fmt: skip
     except InputError as exc:  # all diagnoses doubtful
         return {"status": str(exc)}, sum(r.get("verdict") == "doubtful" for r in flights), dict
-    return report["first_failure"], report["doubtful_left_out"], lambda: series(flights, report, options)
-
-
-def series(flights: list[dict[str, Any]], report: dict[str, Any], options: dict[str, Any]) -> dict[str, Any]:
-    from .fleet_series import series as drawn
-
-    return drawn(flights, report, options["include_doubtful"])
+    include = options["include_doubtful"]
+    return report["first_failure"], report["doubtful_left_out"], lambda: series(flights, report, include)
 
 
 def _reason(

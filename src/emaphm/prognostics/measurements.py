@@ -37,11 +37,12 @@ def measurement(row: dict[str, Any], name: str) -> tuple[float, float] | None:
     """(value, sd) of a fault in one row, or None where the row tells nothing about it."""
     memo = row.setdefault("_measured", {})
     if name not in memo:
-        memo[name] = _measured_now(row, name)
+        memo[name] = _measure(row, name)
     return memo[name]  # type: ignore[no-any-return]
 
 
-def _measured_now(row: dict[str, Any], name: str) -> tuple[float, float] | None:
+def _measure(row: dict[str, Any], name: str) -> tuple[float, float] | None:
+    """`measurement`, computed (it keeps the answer in the row)."""
     column = FAULTS[name][0]
     j = int(column[1:]) - 1
     if row.get("verdict") not in USED_VERDICTS:  # "does not fit" sizes nothing; doubtful ones chosen before
