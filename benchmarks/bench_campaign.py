@@ -2,6 +2,7 @@
 
     python benchmarks/bench_campaign.py [--jobs 16] [--tiny 60] [--case-seed 5101]
     python benchmarks/bench_campaign.py --load 100000
+    python benchmarks/bench_campaign.py --fleet 1000
 
 Smallest run (the smoke test): ``--jobs 2 --tiny 2 --pop-size 4 --generations 1 --no-polish``,
 and ``--load 10``.
@@ -17,6 +18,10 @@ Reported in BENCHMARKS.md, "Fleet campaigns".
    intervals, a 0.2 s chirp) through the same campaign: (loop wall x workers - the jobs' own
    wall time) / jobs, the cluster's start excluded (target <= 50 ms).
 The estimates of both runs are compared (they must be identical).
+
+--fleet N instead runs one campaign of N such actuators on the LocalCluster alone (issue 36's
+fleet of 1 000 identifications): identifications per hour with and without the cluster's start, per
+core, the jobs' own median time, and how many ended "fits", "doubtful" or failed.
 
 --load N instead times reading a campaign file of N actuators (one-off twin measurements, the
 script's seed), `load_campaign`, and making its jobs with their keys and fingerprints,
@@ -68,16 +73,42 @@ def load_time(n: int, seed: int) -> None:
           f"together {min(reads) + min(makes):.2f} s (best of 3); peak memory {peak:.0f} MB")  # fmt: skip
 
 
+def fleet_throughput(n: int, seed: int) -> None:
+    """--fleet: n identifications at the default budget in one campaign on a LocalCluster."""
+    from collections import Counter
+
+    cores = len(os.sched_getaffinity(0))
+    print(machine_line(f"a fleet campaign of {n} actuators (seed {seed}), default budget, {cores} workers"))
+    with tempfile.TemporaryDirectory() as name:
+        tmp = Path(name)
+        spec = spec_file(tmp, "fleet", draw_cases(n, seed))
+        summary = run_campaign(spec, tmp / "store", workers=cores)
+        rows = ResultStore(tmp / "store").read("results", "fleet").to_pylist()
+    loop = summary.wall_time_s - summary.startup_s
+    per_h = 3600.0 * summary.done
+    verdicts = Counter(str(r.get("verdict")) for r in rows)
+    print(f"campaign, {summary.backend}: {summary.done} done, {summary.failed} failed in {summary.wall_time_s:.0f} s "
+          f"({summary.startup_s:.1f} s start): {per_h / summary.wall_time_s:.0f} identifications/h "
+          f"({per_h / loop:.0f} without the start; {per_h / summary.wall_time_s / cores:.0f} per core)")  # fmt: skip
+    walls = [r["wall_time_s"] for r in rows]
+    print(f"the jobs' own time: median {np.median(walls):.2f} s, p90 {np.percentile(walls, 90):.2f} s; "
+          f"verdicts {dict(sorted(verdicts.items()))}")  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=16)
     parser.add_argument("--tiny", type=int, default=60)
     parser.add_argument("--case-seed", type=int, default=5101)
     parser.add_argument("--load", type=int, default=None, help="time reading a campaign of N actuators instead")
+    parser.add_argument("--fleet", type=int, default=None, help="one campaign of N actuators on the cluster alone")
     add_settings(parser)
     args = parser.parse_args(argv)
     if args.load is not None:
         load_time(args.load, args.case_seed)
+        return
+    if args.fleet is not None:
+        fleet_throughput(args.fleet, args.case_seed)
         return
     cores = len(os.sched_getaffinity(0))
     print(

@@ -47,11 +47,15 @@ def test_recovers_known_faults_on_a_small_budget(measured, small_polish, case, t
     err = absolute_errors(ident.faults_, truth)
     assert np.all(np.delete(err, 6) < tol), err
     pop, gen = small_polish
-    # the GA, the polish of its best point and of its runner-up, the final check of the shorts (8),
-    # one more polish if a candidate fits better, and the least-squares polish (a Jacobian of 8
-    # rows per residual evaluation at most, and the final value)
+    # the GA, the CMA-ES polish of its best point, the least-squares polish of up to
+    # POLISH_CANDIDATES - 1 runner-ups (each: its start, at most LS_MAX_NFEV trial points and one
+    # Jacobian of 8 rows more than them) and the winner's value, the final check of the shorts (8),
+    # one more CMA-ES polish if a candidate fits better, and the last least-squares polish (a
+    # Jacobian of 8 rows per residual evaluation at most, and the final value)
+    lm = 1 + limits.LS_MAX_NFEV + 8 * (limits.LS_MAX_NFEV + 1)
     ls = 1 + limits.LS_MAX_NFEV * (1 + 8) + 1
-    assert ident.run_.evaluations <= 16 * 6 + 3 * pop * (gen + 1) + 8 + ls
+    cma = pop * (gen + 1)
+    assert ident.run_.evaluations <= 16 * 6 + cma + (limits.POLISH_CANDIDATES - 1) * lm + 1 + 8 + cma + ls
 
 
 def test_same_seed_same_estimate_other_seed_differs(measured):
@@ -83,7 +87,12 @@ def test_same_seed_same_estimate_other_seed_differs_through_every_stage(measured
 
 
 def test_the_least_squares_polish_ends_the_identification_and_never_makes_it_worse(measured, monkeypatch):
-    monkeypatch.setattr(limits, "POLISH_BUDGET", (8, 2))  # a tiny search leaves it work to do
+    from emaphm.identification import checks, polish, search
+
+    # without the polish stage and the final checks (which polish what they take) a tiny search
+    # leaves the last polish work to do
+    skipped = (polish.polish_stage, checks.final_checks)
+    monkeypatch.setattr(search, "SEARCH_STAGES", tuple(s for s in search.SEARCH_STAGES if s not in skipped))
     _, r = measured["friction+shortB"]
     ident = FaultIdentifier(seed=3, pop_size=16, generations=3, last_stage="none").fit(r.t, r.i_q)
     assert ident.record("least_squares")["gain"] < 0.9

@@ -87,33 +87,46 @@ def two_basins(X):
     return np.minimum(np.sum((X - A) ** 2, axis=1) * 50 + 0.05, np.sum((X - B) ** 2, axis=1) * 50)
 
 
-def test_the_runner_up_is_the_best_member_of_another_basin():
-    from emaphm.identification.polish import runner_up
+def two_basins_residuals(X):
+    """Residual vectors whose Σ r² is `two_basins`: the lower bowl's, its floor as a last entry."""
+    X = np.atleast_2d(X)
+    in_a = np.sum((X - A) ** 2, axis=1) * 50 + 0.05 < np.sum((X - B) ** 2, axis=1) * 50
+    centre = np.where(in_a[:, None], A, B)
+    floor = np.where(in_a, np.sqrt(0.05), 0.0)
+    return np.concatenate([np.sqrt(50.0) * (X - centre), floor[:, None]], axis=1)
+
+
+def test_the_candidates_are_the_best_members_of_other_basins():
+    from emaphm.identification.polish import candidates
 
     close = A + 0.01  # the same basin: within RUNNER_UP_DISTANCE in every fault
     same_phase = A.copy()
     same_phase[6] = A[6] + 0.5  # x7 and x7 + 0.5 give the same k7: not another candidate
     far_good, far_bad = B + 0.02, B + 0.1
-    population = np.array([A, close, same_phase, far_bad, far_good])
+    far_good_twin = far_good + 0.01  # close to far_good: not a candidate beside it
+    population = np.array([A, close, same_phase, far_bad, far_good_twin, far_good])
     run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
-    second = runner_up(run)
-    assert second is not None
-    np.testing.assert_array_equal(second.x, far_good)
-    assert (
-        runner_up(OptimizerRun(A.copy(), 0.05, 10, [1.0], population[:3], two_basins(population[:3]))) is None
-    )
-    assert runner_up(OptimizerRun(A.copy(), 0.05, 10, [1.0])) is None  # no population (a polish's run)
+    starts = candidates(run, 5)
+    assert [c.f for c in starts] == sorted(c.f for c in starts)  # best first
+    np.testing.assert_array_equal(starts[0].x, A)
+    np.testing.assert_array_equal(starts[1].x, far_good)
+    np.testing.assert_array_equal(starts[2].x, far_bad)
+    assert len(starts) == 3 and starts[1].evaluations == 0
+    assert len(candidates(run, 2)) == 2
+    assert len(candidates(OptimizerRun(A.copy(), 0.05, 10, [1.0], population[:3], two_basins(population[:3])), 5)) == 1
+    assert len(candidates(OptimizerRun(A.copy(), 0.05, 10, [1.0]), 5)) == 1  # no population (a polish's run)
 
 
-def test_polishing_the_runner_up_escapes_a_neighbouring_basin():
-    from emaphm.identification.polish import polish_two
+def test_polishing_the_runner_ups_escapes_a_neighbouring_basin():
+    from emaphm.identification.polish import polish_runner_ups
 
     population = np.array([A, A - 0.01, B + 0.05])
     run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
-    out, won = polish_two(two_basins, run, seed=1)
-    assert won and out.f < 1e-4 and np.max(np.abs(out.x - B)) < 0.01
-    assert out.evaluations > 10 + 32 and out.history[0] == 1.0
+    kept = OptimizerRun(A.copy(), 0.05, 30, [1.0, 0.05])  # the best point, polished in its shallow basin
+    out, won = polish_runner_ups(two_basins_residuals, two_basins, run, kept, 5)
+    assert won == 1 and out.f < 1e-8 and np.max(np.abs(out.x - B)) < 1e-4
+    assert out.evaluations > 30 + 9 and out.history == [1.0, 0.05]  # kept's history, all evaluations
     # when the best point's basin is the deep one, it stays
     swapped = OptimizerRun(B.copy(), 0.0, 10, [0.0], population[::-1], two_basins(population[::-1]))
-    kept, won = polish_two(two_basins, swapped, seed=1)
-    assert not won and kept.f == 0.0
+    stays, won = polish_runner_ups(two_basins_residuals, two_basins, swapped, swapped, 5)
+    assert won == 0 and stays.f == 0.0 and np.array_equal(stays.x, B)

@@ -2,7 +2,7 @@
 
 The values are *choices*, measured where a line says so; `as_dict` writes them into every result
 (``settings["limits"]``), together with the comparison's own (`signals`, `weights`). The stages
-read them from this module when they run (``limits.POLISH_BUDGET``), so a test or a study changes
+read them from this module when they run (``limits.POLISH_CANDIDATES``), so a test or a study changes
 one of them here, for all stages at once. The user's options are `settings.IdentifySettings`.
 """
 
@@ -47,6 +47,7 @@ __all__ = [
     "PHASE_SIGMAS",
     "PINV_RCOND",
     "POLISH_BUDGET",
+    "POLISH_CANDIDATES",
     "POLISH_PATIENCE",
     "POSITION_SCALE_TOLERANCE",
     "REST_BAND",
@@ -96,6 +97,8 @@ POLISH_PATIENCE = 15  # the CMA-ES polish stops after this many generations with
 # a population member counts as another candidate when one of its faults differs from the best's
 # by more than this (k7 on the circle); measured on bench_multifault's 40 x 2 cases (docs/identification.md §3)
 RUNNER_UP_DISTANCE = 0.05
+# the points the polish starts from: the search's best and up to four distinct runner-ups
+POLISH_CANDIDATES = 5
 # the least-squares polish: the forward-difference step of its Jacobian in the unit box, and its
 # budget of residual evaluations (each Jacobian costs n more, in one batch)
 LS_STEP = 1e-2

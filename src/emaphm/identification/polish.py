@@ -1,9 +1,10 @@
 """Stage 2 and the search's last step: the local polishes of the search's best point.
 
-`polish_stage` refines the best point and its best distinct runner-up from the final population
-with a small CMA-ES each (`polish`, `polish_two`, `runner_up`) and keeps the better; after the
-final checks (`checks`), `least_squares_stage` ends the search with scipy's bounded least squares
-on eq. 3's residual vector (`least_squares_polish`), its Jacobian one batch per iteration. Both
+`polish_stage` refines the best point with a small CMA-ES (`polish`) and its distinct runner-ups
+from the final population by least squares on eq. 3's residual vector (`candidates`,
+`polish_runner_ups`, `lm_polish`: bounded Levenberg–Marquardt, `lm`), and keeps the best; after
+the final checks (`checks`), `least_squares_stage` ends the search with scipy's bounded least
+squares on the same residuals (`least_squares_polish`), its Jacobian one batch per iteration. Both
 run only with the settings' ``polish``.
 """
 
@@ -15,6 +16,7 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .context import Context
+from .lm import levenberg_marquardt
 from .metrics import wrap_phase
 from .optimizers import (
     BatchProblem,
@@ -28,7 +30,15 @@ from .optimizers import (
 from .problem import recentre_phase, search_to_faults
 from .state import Record, State
 
-__all__ = ["least_squares_polish", "least_squares_stage", "polish", "polish_stage", "polish_two", "runner_up"]
+__all__ = [
+    "candidates",
+    "least_squares_polish",
+    "least_squares_stage",
+    "lm_polish",
+    "polish",
+    "polish_runner_ups",
+    "polish_stage",
+]
 
 
 def polish(
@@ -140,63 +150,113 @@ def least_squares_polish(
     )
 
 
-def runner_up(run: OptimizerRun, distance: float | None = None) -> OptimizerRun | None:
-    """The best member of the run's final population that lies more than `distance` (default
-    `limits.RUNNER_UP_DISTANCE`) from its best point in some fault (max norm over k1..k8 in fault
-    space, k7's difference on the circle), as a run to polish; None without a population or when
-    every member is that close.
+def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
+    """`least_squares_polish`'s job by bounded Levenberg–Marquardt on the 8 × 8 normal equations
+    (`lm.levenberg_marquardt`): the runner-ups' polish (`polish_candidates`).
+
+    The same residuals, Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`); it
+    keeps the start if it does not improve on it. scipy's trust-region method works on the
+    10⁴ × 8 Jacobian itself and pays for it on every call (`lm`'s docstring); the search's last
+    polish and the last stage keep it, whose estimates the interval and detection calibrations
+    were fitted to (a Levenberg–Marquardt there moved the final %err by +0.08 ± 0.05 on 80 paired
+    runs, BENCHMARKS.md, issue 36).
+    """
+    x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
+    evaluations = 0
+
+    def batch(X: NDArray[np.float64]) -> NDArray[np.float64]:
+        nonlocal evaluations
+        evaluations += len(X)
+        return np.asarray(residuals(X), dtype=np.float64)
+
+    r0 = batch(x0[None, :])[0]
+    if not np.all(np.isfinite(r0)):
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
+    big = 1e3 * max(float(np.max(np.abs(r0))), 1e-12)
+
+    def finite(X: NDArray[np.float64]) -> NDArray[np.float64]:
+        R = batch(X)
+        return np.where(np.isfinite(R), R, big)
+
+    try:
+        res = levenberg_marquardt(finite, x0, r0, step=limits.LS_STEP, max_nfev=limits.LS_MAX_NFEV)
+    except (ValueError, np.linalg.LinAlgError):
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
+    if not res.f < start.f:
+        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
+    return OptimizerRun(res.x, res.f, start.evaluations + evaluations, [*start.history, res.f])
+
+
+def candidates(run: OptimizerRun, count: int | None = None, distance: float | None = None) -> list[OptimizerRun]:
+    """The run's best point and up to `count` − 1 members of its final population (default
+    `limits.POLISH_CANDIDATES`), best first, each more than `distance` (default
+    `limits.RUNNER_UP_DISTANCE`) from every one taken before in some fault (max norm over k1..k8
+    in fault space, k7's difference on the circle); only the best point without a population.
 
     The GA's final population is still spread (70-95 of 96 members that far on the benchmark
-    cases): a basin next to the one the best point fell in is often held by a member. Polishing it
-    too turned the one wrong basin of the 40 x 2 benchmark runs (case 17 seed 2: 1.25 x the best
-    fitness known, 4.25 %err) into the best basin (1.46 %err).
+    cases): a basin next to the one the best point fell in is often held by a member. Polishing the
+    best such runner-up too turned the one wrong basin of the 40 x 2 benchmark runs (case 17 seed
+    2: 1.25 x the best fitness known, 4.25 %err) into the best basin (1.46 %err).
     """
+    count = limits.POLISH_CANDIDATES if count is None else count
     distance = limits.RUNNER_UP_DISTANCE if distance is None else distance
-    if run.population is None or run.population_f is None or not len(run.population):
-        return None
+    chosen = [run]
+    if run.population is None or run.population_f is None or not len(run.population) or count < 2:
+        return chosen
     K = search_to_faults(run.population)
-    best = search_to_faults(run.x[None, :])[0]
-    d = np.abs(K - best)
-    d[:, 6] = np.abs(wrap_phase(d[:, 6]))
+    taken = [search_to_faults(run.x[None, :])[0]]
     f = np.where(np.isfinite(run.population_f), run.population_f, np.inf)
-    far = np.flatnonzero((d.max(axis=1) > distance) & np.isfinite(f))
-    if not len(far):
-        return None
-    j = int(far[np.argmin(f[far])])
-    return OptimizerRun(run.population[j].copy(), float(f[j]), 0, [])
+    for j in np.argsort(f, kind="stable"):
+        if len(chosen) >= count or not np.isfinite(f[j]):
+            break
+        d = np.abs(K[j] - np.asarray(taken))
+        d[:, 6] = np.abs(wrap_phase(d[:, 6]))
+        if np.all(d.max(axis=1) > distance):
+            chosen.append(OptimizerRun(run.population[j].copy(), float(f[j]), 0, []))
+            taken.append(K[j])
+    return chosen
 
 
-def polish_two(
-    evaluate: Objective,
-    run: OptimizerRun,
-    *,
-    seed: int = 0,
-    on_generation: OnGeneration | None = None,
-) -> tuple[OptimizerRun, bool]:
-    """Polish the search's best point and its best distinct runner-up (`runner_up`); keep the better.
-
-    Both start from the representative of k7 inside the box (`recentre_phase`: a polish cannot
-    move a point at a bound). Returns the run (its history the search's and the first polish's,
-    its evaluations all three) and whether the runner-up's polish gave it.
-    """
-    first = polish(evaluate, recentre_phase(run), seed=seed, on_generation=on_generation)
-    second = runner_up(run)
-    if second is None:
-        return first, False
-    other = polish(evaluate, recentre_phase(second), seed=seed + 1)
-    won = other.f < first.f
-    kept = other if won else first
-    return OptimizerRun(kept.x, kept.f, first.evaluations + other.evaluations, first.history), won
+def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: OptimizerRun, kept: OptimizerRun,
+                      count: int | None = None) -> tuple[OptimizerRun, int]:  # fmt: skip
+    """The least-squares polish (`lm_polish`) of the search's distinct runner-ups (`candidates`
+    but its best point), each from the representative of k7 inside the box (`recentre_phase`: a
+    polish cannot move a point at a bound), against `kept`, the polished best point: the best of
+    them, its value the search's own (`evaluate`, one evaluation), and which runner-up gave it (0:
+    `kept` stands). Evaluations: `kept`'s and all of theirs."""
+    evaluations, best, won = kept.evaluations, None, 0
+    for i, start in enumerate(candidates(search, count)[1:], start=1):
+        polished = lm_polish(residuals, recentre_phase(OptimizerRun(start.x, start.f, 0, [])))
+        evaluations += polished.evaluations
+        if polished.f < kept.f and (best is None or polished.f < best.f):
+            best, won = polished, i
+    if best is None:
+        return OptimizerRun(kept.x, kept.f, evaluations, kept.history), 0
+    f = float(evaluate(best.x[None, :])[0])  # the same number to 1e-12; guards a row that diverges here
+    if not f < kept.f:
+        return OptimizerRun(kept.x, kept.f, evaluations + 1, kept.history), 0
+    return OptimizerRun(best.x, f, evaluations + 1, kept.history), won
 
 
 def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
-    """Stage 2: the CMA-ES polish of the search's best point and of its runner-up (`polish_two`)."""
+    """Stage 2: the CMA-ES polish of the search's best point (`polish`), then the least-squares
+    polish of its distinct runner-ups (`polish_runner_ups`); the best kept.
+
+    Until issue 36 the best runner-up got a CMA-ES polish of its own (up to 1569 evaluations);
+    least squares from up to four of them costs 60–130 LF runs each. Least squares does not
+    replace the best point's CMA-ES: where the valley is narrower than its finite-difference step
+    it stops short (the interval calibration's case 94, seed 4101: 4.2 x the fitness a CMA-ES then
+    reached from its point), and a pipeline started with it moved estimates the calibrations rest
+    on (BENCHMARKS.md, issue 36).
+    """
     assert state is not None  # the search ran
     if not context.settings.polish:
         return state, {"stage": "polish", "ran": False}
-    run, won = polish_two(context.evaluate, state.run, seed=context.seed, on_generation=context.on_generation)
-    # runner_up: whether the polish of the population's best distinct runner-up gave the point
-    return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": won, "fitness": run.f}
+    search = state.run
+    best = polish(context.evaluate, recentre_phase(search), seed=context.seed, on_generation=context.on_generation)
+    run, won = polish_runner_ups(context.residuals(), context.evaluate, search, best)
+    # runner_up: whether a runner-up's polish gave the point (`candidate`: which, 0 the best point)
+    return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": won > 0, "candidate": won, "fitness": run.f}
 
 
 def least_squares_stage(state: State | None, context: Context) -> tuple[State, Record]:

@@ -27,11 +27,27 @@ row; the command line turns it into exit status 2.
 
 from __future__ import annotations
 
-from .channel_map import ChannelMap, ChannelSpec
-from .checks import plausibility
-from .inspection import inspect_file
-from .measurement import Channel, Measurement, load_measurement
-from .reference import Reference, to_reference, write_reference
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
+
+# public name -> module that defines it: imported on first use (PEP 562), so that a module that
+# needs one submodule (`limits`, `grid`) does not load the readers, the alignment's scipy.optimize
+# and the rest (0.2 s of every ``emaphm identify``)
+_LAZY = {
+    "ChannelMap": "channel_map", "ChannelSpec": "channel_map", "plausibility": "checks",
+    "inspect_file": "inspection", "Channel": "measurement", "Measurement": "measurement",
+    "load_measurement": "measurement", "Reference": "reference", "to_reference": "reference",
+    "write_reference": "reference",
+}  # fmt: skip
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, globals())
+
+if TYPE_CHECKING:
+    from .channel_map import ChannelMap, ChannelSpec
+    from .checks import plausibility
+    from .inspection import inspect_file
+    from .measurement import Channel, Measurement, load_measurement
+    from .reference import Reference, to_reference, write_reference
 
 __all__ = [
     "Channel",

@@ -1,0 +1,79 @@
+"""The bounded Levenberg–Marquardt solver of the polishes (`identification.lm`), against scipy's
+`least_squares` as the independent reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import least_squares
+
+from emaphm.identification.lm import levenberg_marquardt
+
+T = np.linspace(0.0, 1.0, 400)
+
+
+def _decay(x):
+    """A damped-oscillation fit, m = 400 samples of 3 parameters in [0, 1], rows of x → rows of r."""
+    x = np.atleast_2d(x)
+    a, k, w = x[:, :1], x[:, 1:2], x[:, 2:3]
+    truth = 0.7 * np.exp(-3.0 * 0.4 * T) * np.cos(20.0 * 0.55 * T)
+    return a * np.exp(-3.0 * k * T) * np.cos(20.0 * w * T) - truth
+
+
+def _solve(fun, x0, **kw):
+    x0 = np.asarray(x0, dtype=float)
+    return levenberg_marquardt(fun, x0, fun(x0[None, :])[0], **kw)
+
+
+@pytest.mark.parametrize("x0", [(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45)])
+def test_reaches_the_minimum_scipy_reaches(x0):
+    res = _solve(_decay, x0, step=1e-6, max_nfev=200)
+    ref = least_squares(lambda x: _decay(x)[0], x0, bounds=(0.0, 1.0), method="trf")
+    assert res.f == pytest.approx(2.0 * ref.cost, abs=1e-12)
+    np.testing.assert_allclose(res.x, ref.x, atol=1e-5)
+    np.testing.assert_allclose(res.x, [0.7, 0.4, 0.55], atol=1e-5)  # the truth: a zero residual
+    assert res.status in ("ftol", "xtol")
+
+
+def test_a_minimum_outside_the_box_ends_on_its_bound_as_scipys():
+    # the truth's amplitude 0.7 is out of reach when the box stops at 0.5: the fit is held there
+    def fun(x):
+        return _decay(np.atleast_2d(x) * np.array([0.5 / 1.0, 1.0, 1.0]))
+
+    res = _solve(fun, (0.4, 0.5, 0.5), step=1e-6, max_nfev=200)
+    ref = least_squares(lambda x: fun(x)[0], (0.4, 0.5, 0.5), bounds=(0.0, 1.0), method="trf")
+    assert res.x[0] == 1.0  # on the bound exactly, not near it
+    assert res.f == pytest.approx(2.0 * ref.cost, rel=1e-6)
+    assert np.all((res.x >= 0.0) & (res.x <= 1.0))
+
+
+def test_never_worse_than_its_start_and_keeps_to_the_budget():
+    calls = []
+
+    def counted(X):
+        calls.append(len(X))
+        return _decay(X)
+
+    x0 = np.array([0.1, 0.9, 0.2])
+    f0 = float(np.sum(_decay(x0) ** 2))
+    res = _solve(counted, x0, step=1e-4, max_nfev=3)
+    assert res.nfev <= 3 and res.status == "budget"
+    assert res.f <= f0 * (1.0 + 1e-12)
+    # the trial points counted by nfev, the Jacobians in batches of n rows by njev (and the start)
+    assert sum(calls) == 1 + res.nfev + 3 * res.njev
+
+
+def test_a_rejected_step_damps_and_retries_without_a_new_jacobian():
+    # r = atan(20 (x - 0.5)) from x = 0.99: the Gauss-Newton step (-2.4) leaves the box, its
+    # projection onto 0 fits no better; the damped retries, without new Jacobians, then get there
+    sizes = []
+
+    def atan(X):
+        sizes.append(len(X))
+        return np.arctan(20.0 * (np.atleast_2d(X) - 0.5))
+
+    res = _solve(atan, (0.99,), step=1e-7, max_nfev=100)
+    assert res.x[0] == pytest.approx(0.5, abs=1e-6)
+    trials = sizes[1:]  # after the start: a Jacobian is one row here too, so count by order
+    assert res.nfev > res.njev  # some Jacobian was followed by more than one trial point
+    assert len(trials) == res.nfev + res.njev
