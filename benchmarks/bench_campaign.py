@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -82,7 +83,12 @@ def fleet_throughput(n: int, seed: int) -> None:
     with tempfile.TemporaryDirectory() as name:
         tmp = Path(name)
         spec = spec_file(tmp, "fleet", draw_cases(n, seed))
-        summary = run_campaign(spec, tmp / "store", workers=cores)
+
+        def progress(done: int, failed: int, todo: int, elapsed: float) -> None:  # todo: the run's jobs
+            if (done + failed) % 50 == 0 or done + failed == todo:
+                print(f"  {done + failed} of {todo} jobs, {elapsed:.0f} s", file=sys.stderr, flush=True)
+
+        summary = run_campaign(spec, tmp / "store", workers=cores, progress=progress)
         rows = ResultStore(tmp / "store").read("results", "fleet").to_pylist()
     loop = summary.wall_time_s - summary.startup_s
     per_h = 3600.0 * summary.done

@@ -2,7 +2,7 @@
 
 The values are *choices*, measured where a line says so; `as_dict` writes them into every result
 (``settings["limits"]``), together with the comparison's own (`signals`, `weights`). The stages
-read them from this module when they run (``limits.POLISH_CANDIDATES``), so a test or a study changes
+read them from this module when they run (``limits.POLISH_BUDGET``), so a test or a study changes
 one of them here, for all stages at once. The user's options are `settings.IdentifySettings`.
 """
 

@@ -70,6 +70,30 @@ def polish(
     return OptimizerRun(x, f, start.evaluations + problem.evaluations, [*start.history, *history])
 
 
+class _Counted:
+    """A polish's residuals (`batch`: rows of the box → residual vectors), their evaluations
+    counted, the start's residual `r0`, and `finite`: a residual that is not finite replaced by a
+    large one (10³ × the start's largest), so that a trial point that diverges is rejected."""
+
+    def __init__(self, residuals: Residuals, x0: NDArray[np.float64]) -> None:
+        self.residuals, self.evaluations = residuals, 0
+        self.r0 = self.batch(x0[None, :])[0]
+        self.big = 1e3 * max(float(np.max(np.abs(self.r0))), 1e-12) if np.all(np.isfinite(self.r0)) else np.inf
+
+    def batch(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
+        self.evaluations += len(X)
+        return np.asarray(self.residuals(X), dtype=np.float64)
+
+    def finite(self, R: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.where(np.isfinite(R), R, self.big)
+
+    def kept(self, start: OptimizerRun, x: NDArray[np.float64] | None = None, f: float = np.inf) -> OptimizerRun:
+        """The polished point (x, f) if it improves on the start, else the start; evaluations counted."""
+        if x is None or not f < start.f:
+            return OptimizerRun(start.x, start.f, start.evaluations + self.evaluations, start.history)
+        return OptimizerRun(x, f, start.evaluations + self.evaluations, [*start.history, f])
+
+
 def least_squares_polish(
     residuals: Residuals,
     start: OptimizerRun,
@@ -99,20 +123,10 @@ def least_squares_polish(
 
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
     n = len(x0)
-    evaluations = 0
-
-    def batch(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        nonlocal evaluations
-        evaluations += len(X)
-        return np.asarray(residuals(X), dtype=np.float64)
-
-    r0 = batch(x0[None, :])[0]
+    counted = _Counted(residuals, x0)
+    batch, finite, r0 = counted.batch, counted.finite, counted.r0
     if not np.all(np.isfinite(r0)):
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    big = 1e3 * max(float(np.max(np.abs(r0))), 1e-12)
-
-    def finite(R: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.where(np.isfinite(R), R, big)
+        return counted.kept(start)
 
     # the point scipy evaluated last and its residual: it evaluates its start once more, and takes
     # the Jacobian at the point it has just evaluated and accepted
@@ -141,18 +155,13 @@ def least_squares_polish(
             max_nfev=max_nfev,
         )  # fmt: skip
     except (ValueError, np.linalg.LinAlgError):
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    f = 2.0 * float(res.cost)
-    if not f < start.f:
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    return OptimizerRun(
-        np.asarray(res.x, dtype=np.float64), f, start.evaluations + evaluations, [*start.history, f]
-    )
+        return counted.kept(start)
+    return counted.kept(start, np.asarray(res.x, dtype=np.float64), 2.0 * float(res.cost))
 
 
 def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
     """`least_squares_polish`'s job by bounded Levenberg–Marquardt on the 8 × 8 normal equations
-    (`lm.levenberg_marquardt`): the runner-ups' polish (`polish_candidates`).
+    (`lm.levenberg_marquardt`): the runner-ups' polish (`polish_runner_ups`).
 
     The same residuals, Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`); it
     keeps the start if it does not improve on it. scipy's trust-region method works on the
@@ -162,29 +171,17 @@ def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
     runs, BENCHMARKS.md, issue 36).
     """
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
-    evaluations = 0
-
-    def batch(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        nonlocal evaluations
-        evaluations += len(X)
-        return np.asarray(residuals(X), dtype=np.float64)
-
-    r0 = batch(x0[None, :])[0]
-    if not np.all(np.isfinite(r0)):
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    big = 1e3 * max(float(np.max(np.abs(r0))), 1e-12)
-
-    def finite(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        R = batch(X)
-        return np.where(np.isfinite(R), R, big)
-
+    counted = _Counted(residuals, x0)
+    if not np.all(np.isfinite(counted.r0)):
+        return counted.kept(start)
     try:
-        res = levenberg_marquardt(finite, x0, r0, step=limits.LS_STEP, max_nfev=limits.LS_MAX_NFEV)
+        res = levenberg_marquardt(
+            lambda X: counted.finite(counted.batch(X)), x0, counted.r0, step=limits.LS_STEP,
+            max_nfev=limits.LS_MAX_NFEV,
+        )  # fmt: skip
     except (ValueError, np.linalg.LinAlgError):
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    if not res.f < start.f:
-        return OptimizerRun(start.x, start.f, start.evaluations + evaluations, start.history)
-    return OptimizerRun(res.x, res.f, start.evaluations + evaluations, [*start.history, res.f])
+        return counted.kept(start)
+    return counted.kept(start, res.x, res.f)
 
 
 def candidates(run: OptimizerRun, count: int | None = None, distance: float | None = None) -> list[OptimizerRun]:
