@@ -17,17 +17,14 @@ Prints what it found; exit 0 when all hold, 1 otherwise, 2 when no browser is in
 
 from __future__ import annotations
 
-import argparse
 import json
 import re
-import subprocess
 import sys
-import tempfile
 from html.parser import HTMLParser
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_report_in_browser import FLAGS, browser, rendered_dom
+from check_report_in_browser import rendered_dom, require_browser, run_main, take_screenshot
 
 sys.path.pop(0)
 
@@ -206,9 +203,7 @@ def _verdict_problems(d: FleetDom) -> list[str]:
 
 def check(folder: Path, screenshot: Path | None = None) -> list[str]:
     """The problems found in the rendered fleet page ``folder/index.html`` (empty when it is fine)."""
-    exe = browser()
-    if exe is None:
-        raise FileNotFoundError("no headless browser: apt install chromium")
+    exe = require_browser()
     page = folder / "index.html"
     dom = rendered_dom(page, exe)
     problems = []
@@ -222,29 +217,12 @@ def check(folder: Path, screenshot: Path | None = None) -> list[str]:
         problems.append("the first chart has no width once its details are open")
     problems += page_problems(dom, folder)
     if screenshot is not None:
-        with tempfile.TemporaryDirectory() as profile:
-            subprocess.run(
-                [exe, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={screenshot}",
-                 "--window-size=1400,1800", page.resolve().as_uri()],
-                capture_output=True, timeout=120, check=False,
-            )  # fmt: skip
+        take_screenshot(page, exe, screenshot, 1400)
     return problems
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("folder", type=Path)
-    parser.add_argument("--screenshot", type=Path, default=None)
-    args = parser.parse_args()
-    try:
-        problems = check(args.folder, args.screenshot)
-    except FileNotFoundError as exc:
-        print(f"check_fleet_in_browser: {exc}", file=sys.stderr)
-        sys.exit(2)
-    for p in problems:
-        print(f"problem: {p}")
-    print("fleet page OK in headless Chromium" if not problems else f"{len(problems)} problem(s)")
-    sys.exit(1 if problems else 0)
+    run_main(check, "check_fleet_in_browser", "folder", "fleet page")
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 FLAGS = [
@@ -44,11 +45,45 @@ def rendered_dom(page: Path, exe: str) -> str:
     return res.stdout
 
 
-def check(report: Path, screenshot: Path | None = None) -> list[str]:
-    """The problems found in the rendered report (empty when it is fine)."""
+def require_browser() -> str:
+    """The headless browser's executable, or FileNotFoundError saying how to install one."""
     exe = browser()
     if exe is None:
         raise FileNotFoundError("no headless browser: apt install chromium")
+    return exe
+
+
+def take_screenshot(page: Path, exe: str, screenshot: Path, width: int) -> None:
+    """Save the rendered page as a PNG, `width` × 1800 pixels."""
+    with tempfile.TemporaryDirectory() as profile:
+        subprocess.run(
+            [exe, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={screenshot}", f"--window-size={width},1800",
+             page.resolve().as_uri()],
+            capture_output=True, timeout=120, check=False,
+        )  # fmt: skip
+
+
+def run_main(check: Callable[[Path, Path | None], list[str]], name: str, argument: str, what: str) -> None:
+    """A checker's command line: ``name ARGUMENT [--screenshot PNG]``; exit 0 when `what` is fine,
+    1 with a line per problem, 2 without a browser or the page."""
+    parser = argparse.ArgumentParser(description=(sys.modules["__main__"].__doc__ or name).splitlines()[0])
+    parser.add_argument(argument, type=Path)
+    parser.add_argument("--screenshot", type=Path, default=None)
+    args = parser.parse_args()
+    try:
+        problems = check(getattr(args, argument), args.screenshot)
+    except FileNotFoundError as exc:
+        print(f"{name}: {exc}", file=sys.stderr)
+        sys.exit(2)
+    for p in problems:
+        print(f"problem: {p}")
+    print(f"{what} OK in headless Chromium" if not problems else f"{len(problems)} problem(s)")
+    sys.exit(1 if problems else 0)
+
+
+def check(report: Path, screenshot: Path | None = None) -> list[str]:
+    """The problems found in the rendered report (empty when it is fine)."""
+    exe = require_browser()
     page = report / "index.html"
     source = page.read_text(encoding="utf-8")
     dom = rendered_dom(page, exe)
@@ -63,12 +98,7 @@ def check(report: Path, screenshot: Path | None = None) -> list[str]:
     if outside:
         problems.append(f"the page refers to files or addresses outside itself: {outside[:3]}")
     if screenshot is not None:
-        with tempfile.TemporaryDirectory() as profile:
-            subprocess.run(
-                [exe, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={screenshot}", "--window-size=1100,1800",
-                 page.resolve().as_uri()],
-                capture_output=True, timeout=120, check=False,
-            )  # fmt: skip
+        take_screenshot(page, exe, screenshot, 1100)
     return problems
 
 
@@ -99,19 +129,7 @@ def _content_problems(dom: str) -> list[str]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("report", type=Path)
-    parser.add_argument("--screenshot", type=Path, default=None)
-    args = parser.parse_args()
-    try:
-        problems = check(args.report, args.screenshot)
-    except FileNotFoundError as exc:
-        print(f"check_report_in_browser: {exc}", file=sys.stderr)
-        sys.exit(2)
-    for p in problems:
-        print(f"problem: {p}")
-    print("report OK in headless Chromium" if not problems else f"{len(problems)} problem(s)")
-    sys.exit(1 if problems else 0)
+    run_main(check, "check_report_in_browser", "report", "report")
 
 
 if __name__ == "__main__":

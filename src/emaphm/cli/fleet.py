@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import InputError
-from .options import UnitOption
+from .options import IncludeDoubtfulOption, UnitOption
 from .output import err
 
 __all__ = ["fleet"]
@@ -35,10 +35,7 @@ def fleet(
         float, typer.Option(help="Flights (or --unit) to the next inspection: the colours are shares of it.")
     ] = 10.0,
     unit: UnitOption = "flights",
-    include_doubtful: Annotated[
-        bool,
-        typer.Option("--include-doubtful", help='Track the diagnoses with verdict "doubtful" too.'),
-    ] = False,
+    include_doubtful: IncludeDoubtfulOption = False,
     seed: Annotated[int, typer.Option(help="Seed of the RUL draws (as emaphm rul).")] = 0,
     output: Annotated[
         Path | None,

@@ -20,6 +20,7 @@ __all__ = [
     "MONITOR_HELP",
     "PARAMS_HELP",
     "CalibrationOption",
+    "IncludeDoubtfulOption",
     "MonitorOption",
     "OptimizerOption",
     "ParamsNeedCalibrationOption",
@@ -52,6 +53,13 @@ UnitOption = Annotated[
     typer.Option(
         help="flights, hours or cycles: the unit of --inspection-interval and of the due RUL (hours and "
         "cycles from the campaign's usage per flight)."
+    ),
+]  # emaphm rul, emaphm fleet
+IncludeDoubtfulOption = Annotated[
+    bool,
+    typer.Option(
+        "--include-doubtful",
+        help='Track the diagnoses with verdict "doubtful" too (default: left out, and counted).',
     ),
 ]  # emaphm rul, emaphm fleet
 

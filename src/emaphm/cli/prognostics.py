@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import InputError
-from .options import UnitOption
+from .options import IncludeDoubtfulOption, UnitOption
 from .output import err
 from .render import print_rul
 
@@ -47,13 +47,7 @@ def rul(
             "Kalman filter (pip install 'emaphm[progpy]')."
         ),
     ] = "trend",
-    include_doubtful: Annotated[
-        bool,
-        typer.Option(
-            "--include-doubtful",
-            help='Track the diagnoses with verdict "doubtful" too (default: left out, and counted).',
-        ),
-    ] = False,
+    include_doubtful: IncludeDoubtfulOption = False,
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write the prognosis figure here (.png).")] = None,
 ) -> None:
