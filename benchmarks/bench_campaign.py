@@ -114,6 +114,8 @@ def main(argv: list[str] | None = None) -> None:
         load_time(args.load, args.case_seed)
         return
     if args.fleet is not None:
+        if args.fleet < 1:
+            parser.error(f"--fleet needs at least 1 actuator, got {args.fleet}")
         fleet_throughput(args.fleet, args.case_seed)
         return
     cores = len(os.sched_getaffinity(0))
