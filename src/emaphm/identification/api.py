@@ -28,7 +28,7 @@ from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
 from .optimizers import OnGeneration
-from .preconditions import motion_doubts
+from .preconditions import estimate_doubts
 from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult
 from .settings import IdentifySettings
@@ -97,17 +97,18 @@ def identify(
         interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings, params)
     warnings += fit_warnings(ident.fit_nrmse_)
     warnings += fit_doubts(ident.fit_nrmse_, *doubtful, ident.record("second_search"))
-    explained = explains(ident.fit_nrmse_)
-    moved, motion = (
-        motion_doubts(ident.context_, ident.faults_, m.trace.t, m.theta_u) if explained else ([], None)
-    )
-    warnings += moved
+    detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds)
+    checked: dict[str, Any] = {"motion": None, "current_scale": None}
+    if explains(ident.fit_nrmse_):
+        with numba_threads(s.workers):
+            warnings += estimate_doubts(
+                ident.context_, ident.faults_, detected, m.trace.t, m.theta_u, params, checked
+            )
     doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
     doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
-    detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds)
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
     record["doubtful_above"] = {"nrmse": doubtful[0], "source": doubtful[1]}  # `verdict.fit_limit`
-    record["motion"] = motion  # `preconditions.motion_doubts`
+    record.update(checked)  # `preconditions.estimate_doubts`: the motion's and the current's scale
     record["baseline"] = used  # `baseline.baseline_inputs`; None: the nameplate
     record["actuator_id"] = actuator_id  # which actuator, for the report and the campaign
     return IdentificationResult(

@@ -1,4 +1,5 @@
-"""Stage 7a: the preconditions of the diagnosis that the motion can check, at the estimate (issue 34).
+"""Stage 7a: the preconditions of the diagnosis checked at the estimate (issue 34): the motion
+here, the current's scale in `current_scale` (`estimate_doubts` runs both).
 
 The monitor, run at the estimate under the recorded command, predicts how the surface moves;
 the measured position must agree with it. Two rig mistakes show there and nowhere else as clearly:
@@ -29,8 +30,9 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import Doubt
 from . import limits
 from .context import Context
+from .current_scale import current_scale, scale_doubts, scale_limit
 
-__all__ = ["lag_and_scale", "motion_doubts"]
+__all__ = ["estimate_doubts", "lag_and_scale", "motion_doubts"]
 
 LAG_ITERATIONS = 20  # Gauss–Newton steps of `lag_and_scale` (a few suffice within the loop's band)
 
@@ -89,3 +91,25 @@ def motion_doubts(
             )
         )
     return doubts, record
+
+
+def estimate_doubts(
+    context: Context,
+    faults: ArrayLike,
+    detected: list[str],
+    t: ArrayLike,
+    theta_u: ArrayLike | None,
+    params: Any,
+    record: dict[str, Any],
+) -> list[str]:
+    """The preconditions checked at the estimate of a fit that explains the recording: the motion
+    (`motion_doubts`) and the current's scale (`current_scale.current_scale`, its limit from the
+    actuator file `params`); their reasons for "doubtful", their records into `record`
+    ("motion", "current_scale")."""
+    doubts, record["motion"] = motion_doubts(context, faults, t, theta_u)
+    scale = current_scale(context, faults, detected)
+    if scale:
+        scale["limit"], scale["limit_source"] = scale_limit(params)
+        doubts += scale_doubts(scale, scale["limit"], scale["limit_source"])
+    record["current_scale"] = scale or None
+    return doubts
