@@ -1,10 +1,13 @@
+import hashlib
 import json
+import os
 
 import h5py
 import numpy as np
 import pytest
 
 import emaphm
+import emaphm.io as eio
 from emaphm import InputError, read_trace, write_trace
 
 
@@ -68,3 +71,22 @@ def test_bad_traces_are_rejected(tmp_path):
     (tmp_path / "back.csv").write_text("t,theta_cmd,theta_u,i_q\n0,0,0,0\n0,0,0,1\n")
     with pytest.raises(InputError, match="increasing"):
         read_trace(tmp_path / "back.csv")
+
+
+def test_a_files_digest_is_read_once_while_it_stays_as_it_was(tmp_path, monkeypatch):
+    path = tmp_path / "healthy.csv"
+    path.write_bytes(b"t,i\n0,1\n")
+    first = eio.sha256_of(path)
+    assert first == hashlib.sha256(b"t,i\n0,1\n").hexdigest()
+
+    def no_open(*args, **kwargs):
+        raise AssertionError("read again")
+
+    monkeypatch.setattr(eio, "open", no_open, raising=False)
+    assert eio.sha256_of(path) == first  # a campaign keys the same recordings several times
+    monkeypatch.undo()
+    # rewritten (even to the same size, the times put back): read again
+    st = os.stat(path)
+    path.write_bytes(b"t,i\n0,2\n")
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert eio.sha256_of(path) == hashlib.sha256(b"t,i\n0,2\n").hexdigest()

@@ -229,12 +229,34 @@ def _read_h5(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     return columns, metadata
 
 
+# digests already taken in this process, by the file's identity and state (`sha256_of`)
+_DIGESTS: dict[tuple[int, ...], str] = {}
+_DIGESTS_KEPT = 4096
+
+
+def _state(path: str | os.PathLike[str]) -> tuple[int, ...]:
+    st = os.stat(path)
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
 def sha256_of(path: str | os.PathLike[str]) -> str:
-    """The SHA-256 of a file (hex), read in 1 MiB blocks: the provenance of an input."""
+    """The SHA-256 of a file (hex), read in 1 MiB blocks: the provenance of an input.
+
+    Read once per process while the file stays as it was (device, inode, size, modification and
+    change times): a campaign run keys its jobs and baselines from the same recordings several
+    times (before and after making the baselines, and for its status), and a fleet's healthy
+    recordings run to many megabytes."""
+    state = _state(path)
+    if state in _DIGESTS:
+        return _DIGESTS[state]
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
+    if _state(path) == state:  # not written to while it was read
+        if len(_DIGESTS) >= _DIGESTS_KEPT:
+            _DIGESTS.clear()
+        _DIGESTS[state] = digest.hexdigest()
     return digest.hexdigest()
 
 
