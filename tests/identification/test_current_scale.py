@@ -49,8 +49,8 @@ def test_a_sensor_gain_is_recovered_and_the_faults_with_it(twin, gain):
 
 def test_the_twin_itself_is_within_the_monitors_own_scatter(twin):
     record = current_scale(_context(twin), TRUTH, {"short_b"})
-    assert abs(record["gain"] - 1.0) < limits.CURRENT_SCALE_SPREAD
-    assert record["fit_ratio"] < limits.CURRENT_SCALE_RATIO
+    assert abs(record["gain"] - 1.0) < limits.CURRENT_SCALE_RATIO_GAIN
+    assert record["fit_ratio"] is None  # within 1 % of 1: the unscaled refit is not needed
     assert scale_doubts(record, *scale_limit(None)) == []
 
 

@@ -78,10 +78,12 @@ def scale_limit(params: Any) -> tuple[float, str]:
 
 def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[str]) -> dict[str, Any]:
     """The monitor refitted with a free scale γ on its current (the module docstring), from the
-    estimate `faults`, with the shorts not in `present` held at 0; and refitted unscaled from the
-    estimate, to compare.
+    estimate `faults`, with the shorts not in `present` held at 0; and, when γ is off 1 by more
+    than `limits.CURRENT_SCALE_RATIO_GAIN` (else neither reason for "doubtful" can hold), refitted
+    unscaled from the estimate, to compare.
 
-    Returns {"gain": γ, "fit_ratio": the unscaled refit's Σ w·e² over the scaled one's, "held":
+    Returns {"gain": γ, "fit_ratio": the unscaled refit's Σ w·e² over the scaled one's (None: not
+    compared), "held":
     the shorts held at 0, "faults_if_scaled": the scaled refit's faults k1..k8, "evaluations":
     monitor runs}; {} when the monitor does not run at the estimate.
     """
@@ -125,10 +127,14 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
     budget, step = limits.CURRENT_SCALE_NFEV, limits.LS_STEP
     x0 = x_est[free]
     fit = levenberg_marquardt(scaled, x0, scaled(x0[None, :])[0], step=step, max_nfev=budget)
-    same = levenberg_marquardt(unscaled, x_est, r_est, step=step, max_nfev=budget)
+    gain = float(scale_of(model(fit.x[None, :]))[0])
+    ratio = None
+    if abs(gain - 1.0) > limits.CURRENT_SCALE_RATIO_GAIN and fit.f > 0:
+        same = levenberg_marquardt(unscaled, x_est, r_est, step=step, max_nfev=budget)
+        ratio = round(same.f / fit.f, 4)
     return {
-        "gain": round(float(scale_of(model(fit.x[None, :]))[0]), 5),
-        "fit_ratio": round(same.f / fit.f, 4) if fit.f > 0 else None,
+        "gain": round(gain, 5),
+        "fit_ratio": ratio,
         "held": [FAULT_NAMES[i] for i in held],
         "faults_if_scaled": [round(float(v), 4) for v in search_to_faults(rows(fit.x[None, :]))[0]],
         "evaluations": count[0],

@@ -109,7 +109,8 @@ def estimate_doubts(
     doubts, record["motion"] = motion_doubts(context, faults, t, theta_u)
     scale = current_scale(context, faults, detected)
     if scale:
-        scale["limit"], scale["limit_source"] = scale_limit(params)
+        limit, scale["limit_source"] = scale_limit(params)
+        scale["limit"] = round(limit, 5)
         doubts += scale_doubts(scale, scale["limit"], scale["limit_source"])
     record["current_scale"] = scale or None
     return doubts
