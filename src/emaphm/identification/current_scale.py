@@ -83,9 +83,8 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
     unscaled from the estimate, to compare.
 
     Returns {"gain": γ, "fit_ratio": the unscaled refit's Σ w·e² over the scaled one's (None: not
-    compared), "held":
-    the shorts held at 0, "faults_if_scaled": the scaled refit's faults k1..k8, "evaluations":
-    monitor runs}; {} when the monitor does not run at the estimate.
+    compared), "held": the shorts held at 0, "faults_if_scaled": the scaled refit's faults k1..k8,
+    "evaluations": monitor runs}; {} when the monitor does not run at the estimate.
     """
     residuals = context.residuals()
     k = np.asarray(faults, dtype=np.float64)
@@ -156,12 +155,13 @@ def scale_doubts(record: dict[str, Any], limit: float, source: str) -> list[str]
         f"{n} {scaled[i]:.3g}" for i, n in enumerate(FAULT_NAMES) if n != "eccentricity_phase"
         and abs(scaled[i] - (0.5 if n == "kp_drift" else 0.0)) >= 0.02
     )  # fmt: skip
+    how = "as well" if off > limit else f"{ratio:.2f} x better"
     return [
         Doubt(
             f"the measured current is {gain:.3f} x what the monitor needs for this motion, beyond the "
             f"±{100 * limit:.1f} % the actuator may differ ({source}), and a scaled current explains the "
-            f"recording {'as well' if off > limit else f'{ratio:.2f} x better'}: a current sensor's gain or scale (check the current channels and the map), or a "
-            f"torque constant off its nameplate (record a baseline: 'emaphm baseline'); scaled, the faults "
-            f"would be {named or 'none'}"
+            f"recording {how}: a current sensor's gain or scale (check the current channels and the map), "
+            "or a torque constant off its nameplate (record a baseline: 'emaphm baseline'); scaled, the "
+            f"faults would be {named or 'none'}"
         )
     ]
