@@ -4,7 +4,7 @@
 """The current's scale γ (`current_scale`) on random twin cases, with and without a sensor gain.
 
     python studies/current_scale.py [--cases 30] [--seed 2611] [--gains 1.0] [--tolerance 0.02 --steps 5e-7,1e-6,2e-6]
-                                    [--params FILE --calibration CAL --uq-calibration UQ]
+                                    [--params FILE --calibration CAL --uq-calibration UQ] [--drive-tolerance 0.1]
 
 Random multi-fault cases (a third of the faults absent) run on the HF twin (noise on; drawn about
 the actuator with --tolerance / --steps), their currents × each gain, identified with the default
@@ -36,6 +36,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--gains", default="1.0", help="comma-separated sensor gains on the currents")
     parser.add_argument("--tolerance", type=float, default=0.0)
     parser.add_argument("--steps", default="", help="the twin's integration steps to draw from [s]")
+    parser.add_argument("--drive-tolerance", type=float, default=0.0, help="an FOC drive's PI gains within ±this")
     parser.add_argument("--params", default=None)
     parser.add_argument("--calibration", default=None)
     parser.add_argument("--uq-calibration", default=None)
@@ -48,8 +49,12 @@ def main(argv: list[str] | None = None) -> None:
     rows: dict[float, list[tuple[float, float, bool]]] = {g: [] for g in gains}
     print(f"# emaphm {emaphm.__version__}, {vars(args)}", flush=True)
     for j, k in enumerate(random_faults(args.cases, args.seed, absent=1 / 3)):
-        drawn = args.tolerance or steps
-        plant = drawn_actuator(params, 1000 + j, tolerance=args.tolerance, steps=steps) if drawn else params
+        drawn = args.tolerance or steps or args.drive_tolerance
+        plant = (
+            drawn_actuator(params, 1000 + j, tolerance=args.tolerance, drive_tolerance=args.drive_tolerance, steps=steps)
+            if drawn
+            else params
+        )
         trace = HighFidelityEma(plant).simulate(k, seed=j)
         for g in gains:
             currents = {n: g * v for n, v in trace.signals.items() if n.startswith("i_")}
