@@ -1,6 +1,6 @@
 """Everyday rig mistakes in a recording: is any answered with a confident wrong diagnosis? (issue 34)
 
-    python benchmarks/bench_rig_mistakes.py [--seed 7] [--only NAME[,NAME...]] [--out DIR]
+    python benchmarks/bench_rig_mistakes.py [--seed 7] [--only NAME[,NAME...]] [--out DIR] [--more]
 
 One actuator (the nominal one) with the newcomer's faults k = 0.30, 0.15, 0, 0.25, 0, 0.10, 0.60,
 0.42 (friction ×1.6, free play, a 25 % short in phase B, eccentricity 0.1, K_P −8 %) is run on the
@@ -140,6 +140,27 @@ def cases(p: int) -> list[tuple[str, str, Callable[[Columns], Columns], Map]]:
     ]
 
 
+def _rows_missing_for(at: float, length: float) -> Callable[[Columns], Columns]:
+    return lambda c: {k: v[~_window(c, at, length)] for k, v in c.items()}
+
+
+def more_cases() -> list[tuple[str, str, Callable[[Columns], Columns], Map]]:
+    """Mistakes of the same kinds at other sizes and places (``--more``): the newcomer's are the
+    default list; these check that the answers do not hang on the sizes chosen there."""
+    same: Callable[[Columns], Columns] = lambda c: c  # noqa: E731
+    return [
+        *[(f"starts_at_{t:g}s", "mistake", _late_start(t), rig_map()) for t in (0.05, 0.35)],
+        *[(f"rows_missing_50ms_at_{t:g}s", "mistake", _rows_missing_for(t, 0.05), rig_map()) for t in (0.1, 0.7)],
+        ("dropout_zeros_at_0.2s", "mistake", _currents_frozen(0.2, True), rig_map()),
+        ("dropout_held_at_0.7s", "mistake", _currents_frozen(0.7, False), rig_map()),
+        *[(f"offset_{d:g}deg_off", "mistake", same, rig_map(OFFSET_DEG + d)) for d in (5, 30, 90)],
+        *[(f"lever_arm_{g:g}", "mistake", _scaled(("cmd", "pos"), g), rig_map()) for g in (0.95, 1.05, 1.2)],
+        ("position_only_1.1", "mistake", _scaled(("pos",), 1.1), rig_map()),
+        *[(f"command_{1000 * d:g}ms_late", "mistake", _command_late(d), rig_map()) for d in (0.002, 0.003)],
+        *[(f"current_gain_{g:g}", "mistake", _scaled(("Ia", "Ib"), g), rig_map()) for g in (1.15, 0.85)],
+    ]
+
+
 def outcome(kind: str, result: emaphm.IdentificationResult | None, err: float | None) -> str:
     if result is None:
         return "refused"
@@ -159,13 +180,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seed", type=int, default=7, help="the twin's noise seed")
     parser.add_argument("--only", default=None, help="comma-separated case names")
     parser.add_argument("--out", type=Path, default=None, help="keep the recordings in this folder")
+    parser.add_argument("--more", action="store_true", help="also the same kinds of mistake at other sizes")
     add_settings(parser)
     args = parser.parse_args(argv)
     params = emaphm.EmaParams()
     print(machine_line(f"truth {TRUTH.tolist()}, twin noise seed {args.seed}, identify seed 1, default settings"))
     twin = emaphm.simulate(TRUTH, seed=args.seed)
     base = rig_columns(twin)
-    chosen = cases(params.motor.p)
+    chosen = cases(params.motor.p) + (more_cases() if args.more else [])
     if args.only:
         names = set(args.only.split(","))
         chosen = [c for c in chosen if c[0] in names]
