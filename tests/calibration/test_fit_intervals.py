@@ -1,9 +1,13 @@
 """The interval calibration's entry point (`calibrate_uq`): its refusals, before any identification."""
 
+import json
+
 import pytest
 
 from emaphm import InputError
 from emaphm.calibration import UQ_CASE_SEED, calibrate_uq
+from emaphm.identification.uncertainty import load_factors
+from tests.helpers import run_cli
 
 
 @pytest.mark.parametrize("cases", [5, 19, 20.0, "160"])
@@ -59,3 +63,19 @@ def test_a_hysteresis_drive_is_calibrated_on_its_own_twin_and_too_many_misfits_r
     fake_identify.clear()
     with pytest.raises(InputError, match="1 of 4 cases did not fit"):
         collect_cases(4, 11)  # 1 of 4 is more than the 10 % allowed
+
+
+def test_the_last_stage_reaches_every_identification_and_the_record(fake_identify, tmp_path, capsys):
+    # the packaged uq_calibration_no_last_stage.json can be remade: calibrate-uq --last-stage none
+    factors = calibrate_uq(cases=20, seed=11, last_stage="none")
+    assert {c["last_stage"] for c in fake_identify} == {"none"} and factors.record["last_stage"] == "none"
+    fake_identify.clear()
+    assert calibrate_uq(cases=20, seed=11).record["last_stage"] == "switching"  # "auto", default monitor
+    with pytest.raises(InputError, match="unknown last stage"):
+        calibrate_uq(cases=20, seed=11, last_stage="bogus")
+    out = tmp_path / "uq.json"
+    fake_identify.clear()
+    code, _, _ = run_cli(["calibrate-uq", "--cases", "20", "--last-stage", "none", "--output", str(out)], capsys)
+    assert code == 0 and {c["last_stage"] for c in fake_identify} == {"none"}
+    assert json.loads(out.read_text())["last_stage"] == "none"  # as the packaged file has it
+    assert load_factors(out, last_stage="none").record["last_stage"] == "none"

@@ -62,6 +62,7 @@ def collect_cases(
     params: EmaParams | None = None,
     drive_tolerance: float = 0.0,
     tolerance: float = 0.0,
+    last_stage: str = "auto",
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
@@ -78,14 +79,13 @@ def collect_cases(
     calibration, monitor : the LF calibration (default: the packaged one) and the monitor model (None: its).
     absent : float
         Probability that each fault of a case is absent (healthy value), in [0, 1].
-    first : int
-        The first case to identify (to resume a set).
+    first : int — the first case to identify (to resume a set).
     progress : callable, optional
         ``progress(stage, done, total)`` after each case.
-    params : EmaParams, optional
-        The actuator (default: the paper's nominal one).
+    params : EmaParams, optional — the actuator (default: the paper's nominal one).
     drive_tolerance, tolerance : float
         The spread of the drawn twins' PI gains (FOC) and of their constants (0: the actuator's own twin).
+    last_stage : the identifications' last stage (`IdentifySettings.last_stage`).
     """
     from ..identification.api import identify
     from ..identification.recording import split_seed
@@ -105,7 +105,7 @@ def collect_cases(
             source = {"reference": HighFidelityEma(plant).simulate(k, seed=split_seed(run_seed)[0])}
         r = identify(
             **source, seed=run_seed, calibration=calibration, monitor=monitor,
-            uncertainty="laplace", uq_calibration=Factors.identity(), params=params,
+            uncertainty="laplace", uq_calibration=Factors.identity(), params=params, last_stage=last_stage,
         )  # fmt: skip
         if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
             skipped.append({"case": i, "faults": k.tolist(), "fit_nrmse": r.fit_nrmse})
@@ -142,6 +142,7 @@ def calibrate_uq(
     params: EmaParams | str | os.PathLike[str] | None = None,
     drive_tolerance: float = DRIVE_TOLERANCE,
     tolerance: float = 0.0,
+    last_stage: str = "auto",
 ) -> Factors:
     """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
 
@@ -171,7 +172,13 @@ def calibrate_uq(
         (`tolerances.drawn_actuator`; 0: the exact twin). Either way the factors are fitted to the
         intervals as identify gives them, widened for the constants (`identification.uncertainty.
         constants`), so that the widening is not counted twice.
+    last_stage : {"auto", "switching", "none"}
+        The identifications' last stage: the factors hold for identifications that end the same way
+        (``emaphm identify --last-stage``; the record says which, `identify` warns on a mismatch).
+        "none" remakes the packaged ``uq_calibration_no_last_stage.json``.
     """
+    from ..identification.last_stage import resolve_last_stage
+
     seed = check_seed(seed)
     if not isinstance(cases, int) or cases < 20:
         raise InputError(f"cases must be a whole number >= 20 (coverage needs a sample), got {cases!r}")
@@ -179,23 +186,23 @@ def calibrate_uq(
         raise InputError(f"drive_tolerance must be in [0, 1), got {drive_tolerance!r}")
     actuator = resolve_params(params)
     lf = MonitorEma(actuator, calibration=calibration, monitor=monitor).calibration
+    stage = resolve_last_stage(last_stage, lf.monitor)  # refused now if unknown
     start = time.perf_counter()
     data = collect_cases(
         cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator,
-        drive_tolerance=drive_tolerance, tolerance=tolerance,
+        drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage,
     )  # fmt: skip
     fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"], added=data["added_std"])
     record = _record(lf, actuator, data, report, cases=cases, seed=seed, drive_tolerance=drive_tolerance,
-                     tolerance=tolerance, wall=time.perf_counter() - start)  # fmt: skip
+                     tolerance=tolerance, wall=time.perf_counter() - start, last_stage=stage)  # fmt: skip
     return Factors(fitted.scale, fitted.floor, record)
 
 
 def _record(
     lf: Calibration, actuator: EmaParams, data: dict[str, Any], report: dict[str, Any], *, cases: int, seed: int,
-    drive_tolerance: float, tolerance: float, wall: float,
+    drive_tolerance: float, tolerance: float, wall: float, last_stage: str,
 ) -> dict[str, Any]:  # fmt: skip
     """The interval calibration's record: how it was made, on what, and its cases' data."""
-    from ..identification.last_stage import resolve_last_stage
     from ..identification.weights import resolve_error_corner
 
     return {
@@ -210,7 +217,7 @@ def _record(
         "error_corner_hz": resolve_error_corner("auto", lf.monitor),
         # the last stage the identifications ran (`switching`): it sets how far estimates fall
         # from the truth, so intervals fitted with one do not hold for the other
-        "last_stage": resolve_last_stage("auto", lf.monitor),
+        "last_stage": last_stage,
         "cases": cases,
         "seed": seed,
         "absent": UQ_ABSENT,

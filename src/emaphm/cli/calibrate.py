@@ -105,10 +105,18 @@ def calibrate_uq(
             help="Draw each case's motor and drive-train constants within ±this (relative; 0: the exact twin)."
         ),
     ] = 0.0,
+    last_stage: Annotated[
+        str,
+        typer.Option(
+            help="The identifications' last stage ('auto', 'switching', 'none'), as 'emaphm identify "
+            "--last-stage': the intervals hold for identifications that end the same way.",
+        ),
+    ] = "auto",
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from ..actuator import resolve_params
     from ..calibration.fit_intervals import calibrate_uq as run_calibrate_uq
+    from ..identification.last_stage import resolve_last_stage
     from ..io import check_output_path
     from ..models import MonitorEma
     from ..models._base import check_seed
@@ -122,12 +130,13 @@ def calibrate_uq(
         raise InputError(f"--tolerance must be in [0, 0.5), got {tolerance:g}")
     check_output_path(output, suffixes=(".json",), inputs=(calibration, params))
     actuator = resolve_params(params)
-    MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
+    lf = MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
+    resolve_last_stage(last_stage, lf.monitor)  # an unknown one: now
     with numba_threads(workers, name="--workers"), progress() as update:
         report = logged(update)
         factors = run_calibrate_uq(
             cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
-            params=actuator, drive_tolerance=drive_tolerance, tolerance=tolerance,
+            params=actuator, drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage,
         )  # fmt: skip
     factors.save(output)
     for case in factors.record["skipped"]:
