@@ -101,9 +101,8 @@ def identify(
     checked: dict[str, Any] = {"motion": None, "current_scale": None}
     if explains(ident.fit_nrmse_):
         with numba_threads(s.workers):
-            warnings += estimate_doubts(
-                ident.context_, ident.faults_, detected, m.trace.t, m.theta_u, params, checked
-            )
+            doubted, checked = estimate_doubts(ident.context_, ident.faults_, detected, m.trace.t, m.theta_u, params)
+        warnings += doubted
     doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
     doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)

@@ -53,6 +53,7 @@ from ..faults import FAULT_NAMES
 from . import limits
 from .context import Context
 from .lm import levenberg_marquardt
+from .polish import CountedResiduals
 from .problem import phase_in_box, search_to_faults
 
 __all__ = ["current_scale", "scale_doubts", "scale_limit"]
@@ -86,20 +87,18 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
     compared), "held": the shorts held at 0, "faults_if_scaled": the scaled refit's faults k1..k8,
     "evaluations": monitor runs}; {} when the monitor does not run at the estimate.
     """
-    residuals = context.residuals()
     k = np.asarray(faults, dtype=np.float64)
     x_est = k.copy()
     x_est[6] = phase_in_box(k[6])
-    r_est = residuals(x_est[None, :])[0]
+    counted = CountedResiduals(context.residuals(), x_est)
+    r_est = counted.r0
     if not np.all(np.isfinite(r_est)):
         return {}
     weights = context.objective.weights
     keep = np.flatnonzero(weights > 0)
     ref = np.sqrt(weights[keep]) * context.objective.comparison.reference[keep]  # √w·I_ref
-    big = 1e3 * float(np.max(np.abs(ref)))  # a diverged run's residual: rejected (`polish._Counted`)
     held = [i for i in SHORTS if FAULT_NAMES[i] not in present]
     free = [i for i in range(len(k)) if i not in held]
-    count = [1]
 
     def rows(Xf: NDArray[np.float64]) -> NDArray[np.float64]:
         X = np.zeros((len(Xf), len(k)))
@@ -107,21 +106,17 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
         return X
 
     def model(Xf: NDArray[np.float64]) -> NDArray[np.float64]:  # √w·I_LF per row
-        count[0] += len(Xf)
-        return ref[None, :] - residuals(rows(Xf))
+        return ref[None, :] - counted.batch(rows(Xf))
 
     def scale_of(M: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.einsum("ij,j->i", M, ref) / np.maximum(np.einsum("ij,ij->i", M, M), 1e-300)  # type: ignore[no-any-return]
 
     def scaled(Xf: NDArray[np.float64]) -> NDArray[np.float64]:
         M = model(Xf)
-        R = ref[None, :] - scale_of(M)[:, None] * M
-        return np.where(np.isfinite(R), R, big)
+        return counted.finite(ref[None, :] - scale_of(M)[:, None] * M)
 
     def unscaled(X: NDArray[np.float64]) -> NDArray[np.float64]:
-        count[0] += len(X)
-        R = residuals(X)
-        return np.where(np.isfinite(R), R, big)
+        return counted.finite(counted.batch(X))
 
     budget, step = limits.CURRENT_SCALE_NFEV, limits.LS_STEP
     x0 = x_est[free]
@@ -136,7 +131,7 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
         "fit_ratio": ratio,
         "held": [FAULT_NAMES[i] for i in held],
         "faults_if_scaled": [round(float(v), 4) for v in search_to_faults(rows(fit.x[None, :]))[0]],
-        "evaluations": count[0],
+        "evaluations": counted.evaluations,
     }
 
 

@@ -31,6 +31,7 @@ from .problem import recentre_phase, search_to_faults
 from .state import Record, State
 
 __all__ = [
+    "CountedResiduals",
     "candidates",
     "least_squares_polish",
     "least_squares_stage",
@@ -70,10 +71,11 @@ def polish(
     return OptimizerRun(x, f, start.evaluations + problem.evaluations, [*start.history, *history])
 
 
-class _Counted:
+class CountedResiduals:
     """A polish's residuals (`batch`: rows of the box → residual vectors), their evaluations
     counted, the start's residual `r0`, and `finite`: a residual that is not finite replaced by a
-    large one (10³ × the start's largest), so that a trial point that diverges is rejected."""
+    large one (10³ × the start's largest), so that a trial point that diverges is rejected. Also
+    the current's scale refits (`current_scale`)."""
 
     def __init__(self, residuals: Residuals, x0: NDArray[np.float64]) -> None:
         self.residuals, self.evaluations = residuals, 0
@@ -123,7 +125,7 @@ def least_squares_polish(
 
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
     n = len(x0)
-    counted = _Counted(residuals, x0)
+    counted = CountedResiduals(residuals, x0)
     batch, finite, r0 = counted.batch, counted.finite, counted.r0
     if not np.all(np.isfinite(r0)):
         return counted.kept(start)
@@ -171,7 +173,7 @@ def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
     runs, BENCHMARKS.md, issue 36).
     """
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
-    counted = _Counted(residuals, x0)
+    counted = CountedResiduals(residuals, x0)
     if not np.all(np.isfinite(counted.r0)):
         return counted.kept(start)
     try:

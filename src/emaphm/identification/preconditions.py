@@ -100,17 +100,15 @@ def estimate_doubts(
     t: ArrayLike,
     theta_u: ArrayLike | None,
     params: Any,
-    record: dict[str, Any],
-) -> list[str]:
+) -> tuple[list[str], dict[str, Any]]:
     """The preconditions checked at the estimate of a fit that explains the recording: the motion
     (`motion_doubts`) and the current's scale (`current_scale.current_scale`, its limit from the
-    actuator file `params`); their reasons for "doubtful", their records into `record`
-    ("motion", "current_scale")."""
-    doubts, record["motion"] = motion_doubts(context, faults, t, theta_u)
+    actuator file `params`); their reasons for "doubtful" and their records {"motion",
+    "current_scale"}."""
+    doubts, motion = motion_doubts(context, faults, t, theta_u)
     scale = current_scale(context, faults, detected)
     if scale:
         limit, scale["limit_source"] = scale_limit(params)
         scale["limit"] = round(limit, 5)
         doubts += scale_doubts(scale, scale["limit"], scale["limit_source"])
-    record["current_scale"] = scale or None
-    return doubts
+    return doubts, {"motion": motion, "current_scale": scale or None}
