@@ -10,8 +10,8 @@ Random multi-fault cases (a third of the faults absent) run on the HF twin (nois
 the actuator with --tolerance / --steps), their currents × each gain, identified with the default
 settings (seed 1). Per run, from the result's ``settings["current_scale"]``: the verdict, %err, γ,
 the fit ratio (the unscaled refit's Σ w·e² over the scaled one's; "-" where γ is within 1 % of 1,
-not compared), the shorts' smallest estimate (their common part), %err of the scaled refit's faults, and whether the
-scale made the result doubtful. Summary per gain: the runs flagged, and |γ − 1| where the scaled
+not compared), the shorts' smallest estimate (their common part), %err of the scaled refit's faults, the shorts
+detected ("!" where the truth has none) and whether the scale made the result doubtful. Summary per gain: the runs flagged, and |γ − 1| where the scaled
 refit fits at least as well (ratio ≥ 1) and where it does not.
 """
 
@@ -22,11 +22,18 @@ import argparse
 import numpy as np
 
 import emaphm
-from emaphm.faults import random_faults
+from emaphm.faults import FAULT_NAMES, random_faults
 from emaphm.identification.current_scale import SHORTS
 from emaphm.models import HighFidelityEma
 from emaphm.results import SimResult
 from emaphm.tolerances import drawn_actuator
+
+
+def shorts_said(detected: list[str], truth: np.ndarray) -> str:
+    """The shorts detected, a false one (the truth's is 0) marked with '!': 'b,c!' or '-'."""
+    names = [FAULT_NAMES[i] for i in SHORTS]
+    said = [n[-1] + ("!" if truth[i] == 0 else "") for n, i in zip(names, SHORTS, strict=True) if n in detected]
+    return ",".join(said) or "-"
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -69,6 +76,7 @@ def main(argv: list[str] | None = None) -> None:
             print(f"{j:3d} gain {g:.3f}: {r.verdict:<12} %err {emaphm.percent_error(r.estimate, k):6.2f}  "
                   f"γ {s['gain']:.4f}  ratio {'-' if s['fit_ratio'] is None else format(s['fit_ratio'], '7.3f'):>7}  common short {min(r.estimate[list(SHORTS)]):.3f}  "
                   f"%err scaled {emaphm.percent_error(s['faults_if_scaled'], k):6.2f}  "
+                  f"shorts detected {shorts_said(r.detected, k)}  "
                   f"{'SCALE DOUBTFUL' if flagged else ''}", flush=True)  # fmt: skip
     for g, got in rows.items():
         if not got:
