@@ -31,16 +31,19 @@ import statistics
 
 import numpy as np
 from _cases import (  # benchmarks/ first on sys.path
+    BUDGET,
     add_settings,
-    budget,
     budget_text,
     covers,
     draw_cases,
     machine_line,
+    settings_of,
 )
 
 import emaphm
 from emaphm import FAULT_NAMES, HEALTHY
+
+SETTINGS = (*BUDGET, "optimizer")  # the identification's settings this benchmark sets
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -51,11 +54,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--healthy", type=int, default=20)
     parser.add_argument("--uq-calibration", default=None)
     parser.add_argument("--uncertainty", default="laplace", choices=("laplace", "mcmc"))
-    add_settings(parser)
+    add_settings(parser, SETTINGS)
     args = parser.parse_args(argv)
     print(machine_line(f"{args.cases} cases (seed {args.case_seed}, absent {args.absent:.3f}), "
                        f"uncertainty {args.uncertainty}, interval calibration {args.uq_calibration or 'packaged'}, "
-                       f"{budget_text(args)}"))  # fmt: skip
+                       f"{budget_text(args)}, optimizer {args.optimizer or 'default'}"))  # fmt: skip
     cases = draw_cases(args.cases, args.case_seed, absent=args.absent)
     inside, scored, half, uq_walls, errs = [], [], [], [], []
     spurious = unsure_zero = zero_faults = found = present_faults = 0
@@ -63,7 +66,7 @@ def main(argv: list[str] | None = None) -> None:
     for i, k in enumerate(cases):
         r = emaphm.identify(
             true_faults=k, seed=i + 1, uncertainty=args.uncertainty, uq_calibration=args.uq_calibration,
-            **budget(args),
+            **settings_of(args, SETTINGS),
         )  # fmt: skip
         if r.uncertainty is None:
             print(f"{i:>4} does not fit (NRMSE {r.fit_nrmse}): no intervals", flush=True)
@@ -117,7 +120,7 @@ def main(argv: list[str] | None = None) -> None:
         alarms = 0
         for s in range(2000, 2000 + args.healthy):
             r = emaphm.identify(
-                true_faults=HEALTHY, seed=s, uq_calibration=args.uq_calibration, **budget(args)
+                true_faults=HEALTHY, seed=s, uq_calibration=args.uq_calibration, **settings_of(args, SETTINGS)
             )
             alarms += bool(r.detected)
             if r.detected:

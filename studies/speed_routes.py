@@ -8,7 +8,9 @@ basins, wall time per identification) with one route applied in this process:
 - ``default``: today's pipeline (GA search, the least-squares polish of the best point and up to
   four distinct runner-ups, the CMA-ES polish of the best of them, the final checks, the last
   least-squares polish, the switching last stage);
-- ``lm-only``: the polish stage without its CMA-ES (least squares of the candidates alone).
+- ``lm-only``: the polish stage without its CMA-ES (least squares of the candidates alone);
+- ``cmaes-only``: the polish stage as the CMA-ES of the best point alone: with
+  ``--optimizer multistart`` (whose own polish stage does nothing) a CMA-ES after its descents.
 
 With ``--pop-size`` / ``--generations`` (bench_multifault's) the GA's budget changes too. The
 routes measured before issue 36's change (the two CMA-ES polishes, smaller ones, none) ran at
@@ -24,27 +26,46 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROUTES = ("default", "lm-only")
+ROUTES = ("default", "lm-only", "cmaes-only")
 
 
 def lm_only_stage(state, context):  # type: ignore[no-untyped-def]
-    """The polish stage as the least squares of the candidates alone (`polish.polish_candidates`)."""
-    from emaphm.identification.polish import polish_candidates
+    """The polish stage as the least squares of the candidates alone: the best point's
+    (`descents.lm_polish`) in place of its CMA-ES, then its runner-ups' (`polish.polish_runner_ups`)."""
+    from emaphm.identification.descents import lm_polish
+    from emaphm.identification.polish import polish_runner_ups
+    from emaphm.identification.problem import recentre_phase
 
     if not context.settings.polish:
         return state, {"stage": "polish", "ran": False}
-    run, won, count = polish_candidates(context.residuals(), context.evaluate, state.run)
+    search = state.run
+    best = lm_polish(context.residuals(), recentre_phase(search))
+    run, won = polish_runner_ups(context.residuals(), context.evaluate, search, best)
     return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": won > 0, "candidate": won,
-                                 "candidates": count, "fitness": run.f}  # fmt: skip
+                                 "fitness": run.f}  # fmt: skip
+
+
+def cmaes_only_stage(state, context):  # type: ignore[no-untyped-def]
+    """The polish stage as the CMA-ES of the best point alone (`polish.polish`)."""
+    from emaphm.identification.polish import polish
+    from emaphm.identification.problem import recentre_phase
+
+    if not context.settings.polish:
+        return state, {"stage": "polish", "ran": False}
+    run = polish(context.evaluate, recentre_phase(state.run), seed=context.seed, on_generation=context.on_generation)
+    return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": False, "candidate": 0, "fitness": run.f}
 
 
 def apply(route: str) -> None:
     from emaphm.identification import polish, search
 
+    def swap(old, new):  # type: ignore[no-untyped-def]
+        search.SEARCH_STAGES = tuple(new if stage is old else stage for stage in search.SEARCH_STAGES)
+
     if route == "lm-only":
-        search.SEARCH_STAGES = tuple(
-            lm_only_stage if stage is polish.polish_stage else stage for stage in search.SEARCH_STAGES
-        )
+        swap(polish.polish_stage, lm_only_stage)
+    elif route == "cmaes-only":
+        swap(polish.polish_stage, cmaes_only_stage)
     elif route != "default":
         raise SystemExit(f"unknown route {route!r}; one of {', '.join(ROUTES)}")
 

@@ -17,7 +17,7 @@ __all__ = [
 ]
 
 # the global search (`identification.search`): the paper's GA, DE, PSO, CMA-ES, grey wolf
-OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo")
+OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo", "multistart")
 # the 90 % intervals of each fault (`identification.uncertainty`)
 UQ_METHODS = ("none", "laplace", "mcmc")
 # the stage after the search (`identification.last_stage`): "auto" runs "switching" with the

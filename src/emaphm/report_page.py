@@ -15,6 +15,8 @@ import html
 import json
 from typing import Any
 
+from .identification.settings import budget_text
+
 __all__ = ["fit_model", "page"]
 
 e = html.escape
@@ -256,7 +258,7 @@ def _settings(data: dict[str, Any], view: dict[str, Any]) -> list[tuple[str, str
     s = data["settings"]
     run = s.get("identify") or {}
     cal, par, uq = (s.get(k) or {} for k in ("calibration", "params", "uq_calibration"))
-    budget = f"{run.get('pop_size', '?')} × {run.get('generations', '?')} generations"
+    budget = budget_text(data["optimizer"], run.get("pop_size"), run.get("generations"))
     return [
         ("optimiser, seed", f"{data['optimizer']}, {data['seed']}"),
         ("budget", budget + (", polish" if run.get("polish") else ", no polish")),

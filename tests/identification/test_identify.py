@@ -110,7 +110,7 @@ def test_the_least_squares_polish_ends_the_identification_and_never_makes_it_wor
     assert plain.record("least_squares") == {"stage": "least_squares", "ran": False}  # no polish asked
 
 
-@pytest.mark.parametrize("name", OPTIMIZERS)
+@pytest.mark.parametrize("name", [o for o in OPTIMIZERS if o != "multistart"])  # it needs residuals: test_multistart
 def test_every_optimizer_runs_and_improves(name):
     # a quadratic bowl in the box: each optimiser must get close within a small budget
     target = np.array([0.2, 0.7, 0.4, 0.1, 0.9, 0.5, 0.3, 0.6])

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from emaphm.identification.lm import levenberg_marquardt
+from emaphm.identification.lm import levenberg_marquardt, levenberg_marquardt_many
 
 T = np.linspace(0.0, 1.0, 400)
 
@@ -77,3 +77,24 @@ def test_a_rejected_step_damps_and_retries_without_a_new_jacobian():
     trials = sizes[1:]  # after the start: a Jacobian is one row here too, so count by order
     assert res.nfev > res.njev  # some Jacobian was followed by more than one trial point
     assert len(trials) == res.nfev + res.njev
+
+
+def test_descents_in_lockstep_take_each_the_path_it_takes_alone():
+    # several starts served in one batch per round: the same end points, values, counts and
+    # stops as one by one, in fewer calls of the residuals (the rows are independent)
+    starts = np.array([(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45), (0.1, 0.9, 0.2)])
+    calls = []
+
+    def counted(X):
+        calls.append(len(X))
+        return _decay(X)
+
+    together = levenberg_marquardt_many(counted, starts, _decay(starts), step=1e-4, max_nfev=40)
+    n_together = len(calls)
+    alone = [_solve(counted, x0, step=1e-4, max_nfev=40) for x0 in starts]
+    assert n_together < len(calls) - n_together
+    for a, b in zip(together, alone, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert (a.f, a.nfev, a.njev, a.status) == (b.f, b.nfev, b.njev, b.status)
+    assert {a.status for a in together} <= {"ftol", "xtol", "budget"}
+    assert len({a.nfev for a in together}) > 1  # they stopped at different rounds

@@ -11,7 +11,7 @@ from emaphm._threads import numba_threads
 from emaphm.identification.fitness import Fitness
 from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.signals import Comparison, sosfiltfilt_padlen
-from emaphm.kernels.fitness import filtered_fitness, fitness_lf_many, pairwise_sum
+from emaphm.kernels.fitness import filtered_fitness, fitness_lf_many, pairwise_sum, residuals_lf_many
 from emaphm.kernels.monitor import IDX
 
 # measured on x86-64 (numpy 2.4, scipy 1.17, numba 0.68): bit-identical. The tolerance leaves
@@ -188,3 +188,43 @@ def test_identification_runs_on_the_fused_kernel(monkeypatch):
     ident = FaultIdentifier(seed=1, pop_size=8, generations=2, polish=False)
     ident.fit(res.t, res.i_q)
     assert len(calls) >= 2 and np.isfinite(ident.fitness_)
+
+
+def python_residuals(fitness, lf, K, duration):
+    """eq. 3's residual vectors by the Python path: LF runs, the comparison filter, numpy."""
+    keep = np.flatnonzero(fitness.weights > 0)
+    filtered = fitness.comparison.filtered(lf.simulate_many(K, duration=duration, check=False))
+    return np.sqrt(fitness.weights[keep]) * (fitness.comparison.reference[keep] - filtered[:, keep])
+
+
+@pytest.mark.parametrize("case", ["noise on, 10001", "3 kHz trace, 9997", "noise off, 500"])
+def test_fused_residuals_equal_the_python_path_and_sum_to_the_fitness(case):
+    build, duration, samples = CASES[case]
+    lf = MonitorEma()
+    rng = np.random.default_rng(len(case) + 1)
+    reference = build(lf, rng.uniform(0, 0.6, 8))
+    mask = (np.arange(samples) % 7 != 3).astype(float)  # samples left out: only the weighed ones come back
+    fitness = Fitness(reference, mask=mask)
+    K = rng.uniform(0, 1, (9, 8))  # an odd number: the kernel pairs rows
+    got = fitness.residuals_of_monitor(lf, K, duration=duration)
+    assert got.shape == (9, int(mask.sum()))
+    np.testing.assert_array_equal(got, python_residuals(fitness, lf, K, duration))
+    np.testing.assert_allclose(np.sum(got**2, axis=1), fitness.of_monitor(lf, K, duration=duration), rtol=1e-12)
+
+
+def test_a_diverged_row_gets_non_finite_residuals_and_the_others_do_not_change():
+    lf = MonitorEma()
+    fitness = Fitness(monitor_reference(lf, [0.2, 0.5, 0, 0.45, 0.04, 0, 0.28, 0.5], True, 0.2))
+    K = np.random.default_rng(6).uniform(0, 1, (5, 8))
+    clean = fitness.residuals_of_monitor(lf, K, duration=0.2)
+    broken = lf.rows(K)
+    broken[4, IDX["V_H"]] = 0.0  # NaN from the first sample on; row 4 is the odd one out
+    out = np.empty_like(clean)
+    _, theta_cmd = lf.sample_grid(0.2)
+    keep = np.flatnonzero(fitness.weights > 0)
+    residuals_lf_many(theta_cmd, broken, fitness.sos, fitness.zi, fitness.padlen, keep,
+                      fitness.comparison.reference[keep], np.sqrt(fitness.weights[keep]), out)  # fmt: skip
+    assert np.all(np.isfinite(clean)) and np.isnan(out[4]).all()
+    np.testing.assert_array_equal(out[:4], clean[:4])
+    with pytest.raises(ValueError, match="500"):
+        Fitness(monitor_reference(lf, np.zeros(8), False, 0.0499)).residuals_of_monitor(lf, K, duration=0.1)

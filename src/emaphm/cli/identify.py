@@ -14,6 +14,7 @@ from typing import Annotated, Any
 import typer
 
 from ..errors import InputError
+from ..identification.settings import search_progress_label
 from .options import (
     CalibrationOption,
     ParamsNeedCalibrationOption,
@@ -123,7 +124,7 @@ def identify(
             params=None if baseline else params, channel_map=map_file, thresholds=None if baseline else thresholds,
             actuator_id=actuator_id, baseline=baseline,
             on_generation=lambda gen, total, best: update(
-                "MCMC steps" if gen < 0 else f"{settings.optimizer.upper()} generations", abs(gen), total
+                "MCMC steps" if gen < 0 else search_progress_label(settings.optimizer), abs(gen), total
             ),
         )  # fmt: skip
     data = result.to_json()

@@ -74,13 +74,9 @@ class Context:
         """Eq. (3)'s residual vectors r = √w·(I_ref − I_LF) over the compared samples for rows X
         of the box: Σ r² per row is `objective` (default: the context's) of those faults."""
         fitness = self.objective if objective is None else objective
-        keep = np.flatnonzero(fitness.weights > 0)
-        root_w = np.sqrt(fitness.weights[keep])
-        reference = fitness.comparison.reference[keep]
 
         def residuals(X: NDArray[np.float64]) -> NDArray[np.float64]:
-            currents = self.monitor.simulate_many(search_to_faults(X), duration=self.duration, check=False)
-            return root_w * (reference - self.reference.filtered(currents)[:, keep])  # type: ignore[no-any-return]
+            return fitness.residuals_of_monitor(self.monitor, search_to_faults(X), duration=self.duration)
 
         return residuals
 

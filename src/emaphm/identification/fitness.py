@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..kernels.fitness import fitness_lf_many
+from ..kernels.fitness import fitness_lf_many, residuals_lf_many
 from .signals import Comparison, comparison_filter
 
 if TYPE_CHECKING:
@@ -84,6 +84,29 @@ class Fitness:
         out.comparison = replace(self.comparison, reference=self.comparison.reference - d)
         return out
 
+    def residuals_of_monitor(
+        self, monitor: MonitorEma, K: ArrayLike, *, duration: float | None = None
+    ) -> NDArray[np.float64]:
+        """eq. (3)'s residual vectors r = √w·(I_ref − I_LF) over the samples it weighs (w > 0) for
+        each fault row of K, shape (m, samples weighed): one parallel kernel call
+        (`kernels.fitness.residuals_lf_many`), Σ r² per row = `of_monitor` to rounding. A row that
+        diverged gets NaN residuals."""
+        _, theta_cmd = monitor.sample_grid(duration)
+        rows = monitor.rows(K)
+        self._check_grid(len(theta_cmd))
+        keep = np.flatnonzero(self.weights > 0)
+        out = np.empty((rows.shape[0], len(keep)))
+        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, self.comparison.reference[keep],
+                          np.sqrt(self.weights[keep]), out)  # fmt: skip
+        return out
+
+    def _check_grid(self, n: int) -> None:
+        ref = self.comparison.reference
+        if n != len(ref):
+            raise ValueError(f"the monitor's grid has {n} samples, the reference {len(ref)}")
+        if len(ref) <= self.padlen:
+            raise ValueError(f"the filter needs more than {self.padlen} samples, got {len(ref)}")
+
     def __call__(self, currents: ArrayLike) -> NDArray[np.float64]:
         residual = self.comparison.reference - self.comparison.filtered(currents)
         return np.sum(self.weights * residual**2, axis=-1)  # type: ignore[no-any-return]
@@ -101,10 +124,7 @@ class Fitness:
         _, theta_cmd = monitor.sample_grid(duration)
         rows = monitor.rows(K)
         ref = self.comparison.reference
-        if len(theta_cmd) != len(ref):
-            raise ValueError(f"the monitor's grid has {len(theta_cmd)} samples, the reference {len(ref)}")
-        if len(ref) <= self.padlen:
-            raise ValueError(f"the filter needs more than {self.padlen} samples, got {len(ref)}")
+        self._check_grid(len(theta_cmd))
         out = np.empty(rows.shape[0])
         fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out)
         return out

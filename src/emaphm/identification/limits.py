@@ -45,6 +45,7 @@ __all__ = [
     "MIN_SPAN",
     "MIN_TAUS",
     "MOTION_LAG_MAX_S",
+    "MULTISTART_DISTANCE",
     "NONSMOOTH_RATIO",
     "NON_IDENTIFIABLE",
     "PARK_SETTLE_S",
@@ -93,7 +94,13 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "pso": (64, 60),
     "cmaes": (64, 60),
     "gwo": (64, 60),
+    # (sample, descents): a Latin hypercube of 256 points, least squares from its 8 best distinct
+    # ones, ≈ 1 500 evaluations (`multistart`, issue 36)
+    "multistart": (256, 8),
 }
+# the multistart's descents start from sample points this far apart in some fault (max norm over
+# k1..k8, k7 on the circle; `polish.candidates`)
+MULTISTART_DISTANCE = 0.1
 
 # ---- the polish (`polish`) ----
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish

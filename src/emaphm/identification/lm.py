@@ -1,4 +1,5 @@
-"""A bounded Levenberg–Marquardt least-squares solver: the runner-ups' polish (`polish.lm_polish`).
+"""A bounded Levenberg–Marquardt least-squares solver: the runner-ups' polish
+and the multistart's descents (`descents.lm_polish_many`).
 
 Minimises f(x) = Σ r(x)² over the box [lower, upper]^n, where r is a residual vector of m ≫ n
 samples (eq. 3's √w·(I_ref − I_LF), m ≈ 10⁴, n = 8) and its Jacobian J is taken by forward
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["LmResult", "levenberg_marquardt"]
+__all__ = ["LmResult", "levenberg_marquardt", "levenberg_marquardt_many"]
 
 Batch = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 
@@ -48,15 +49,129 @@ def _sum_sq(r: NDArray[np.float64]) -> float:
     return float(np.sum(r * r))
 
 
-def _jacobian(batch: Batch, x: NDArray[np.float64], r: NDArray[np.float64], step: float,
-              upper: float) -> NDArray[np.float64]:  # fmt: skip
-    """Jᵀ (n × m, rows contiguous) by forward differences of `step` in one batch of n rows
-    (backward at the upper bound)."""
-    n = len(x)
-    h = np.where(x + step <= upper, step, -step)
-    X = np.repeat(x[None, :], n, axis=0)
-    X[np.arange(n), np.arange(n)] += h
-    return (batch(X) - r) / h[:, None]  # type: ignore[no-any-return]
+class _Descent:
+    """One Levenberg–Marquardt descent as a sequence of requests: `rows` gives the points whose
+    residuals it needs next (a Jacobian's n rows, or one trial point; None once it has stopped),
+    `take` consumes their residuals. `levenberg_marquardt_many` serves several in one batch."""
+
+    def __init__(self, x0: NDArray[np.float64], r0: NDArray[np.float64], step: float, max_nfev: int,
+                 lower: float, upper: float, ftol: float, xtol: float, mu0: float) -> None:  # fmt: skip
+        self.x = np.clip(np.asarray(x0, dtype=np.float64), lower, upper)
+        self.r = np.asarray(r0, dtype=np.float64)
+        self.f = _sum_sq(self.r)
+        self.step, self.max_nfev, self.lower, self.upper = step, max_nfev, lower, upper
+        self.ftol, self.xtol = ftol, xtol
+        self.mu, self.nu, self.nfev, self.njev = mu0, 2.0, 0, 0
+        self.result: LmResult | None = None
+        self.h: NDArray[np.float64] | None = None  # the Jacobian's steps while one is requested
+        self.x_new: NDArray[np.float64] | None = None  # the trial point while one is requested
+        self.A = self.g = self.d = self.free = None
+        if not self.nfev < self.max_nfev:
+            self._stop("budget")
+
+    def _stop(self, status: str) -> None:
+        self.result = LmResult(self.x, self.f, self.nfev, self.njev, status)
+
+    def rows(self) -> NDArray[np.float64] | None:
+        """The points to evaluate next (k × n), None when stopped."""
+        if self.result is not None:
+            return None
+        if self.A is None:  # a Jacobian at x: forward differences (backward at the upper bound)
+            n = len(self.x)
+            self.h = np.where(self.x + self.step <= self.upper, self.step, -self.step)
+            X = np.repeat(self.x[None, :], n, axis=0)
+            X[np.arange(n), np.arange(n)] += self.h
+            return X
+        if self.nfev >= self.max_nfev:
+            self._stop("budget")
+            return None
+        delta = np.zeros_like(self.x)
+        Af = self.A[np.ix_(self.free, self.free)] + self.mu * np.diag(self.d[self.free])
+        try:
+            delta[self.free] = np.linalg.solve(Af, -self.g[self.free])
+        except np.linalg.LinAlgError:
+            self._stop("singular")
+            return None
+        self.x_new = np.clip(self.x + delta, self.lower, self.upper)
+        if np.linalg.norm(self.x_new - self.x) <= self.xtol * (self.xtol + np.linalg.norm(self.x)):
+            self._stop("xtol")
+            return None
+        return self.x_new[None, :]
+
+    def take(self, R: NDArray[np.float64]) -> None:
+        """The residuals of the points `rows` gave."""
+        if self.A is None:
+            Jt = (R - self.r) / self.h[:, None]  # type: ignore[index]
+            self.njev += 1
+            # einsum, not BLAS: the same sums in the same order whatever BLAS's threads (a 1e-16
+            # difference flips an accept/reject near the end and moves the path: review of issue 36)
+            self.A, self.g = np.einsum("ik,jk->ij", Jt, Jt), np.einsum("ik,k->i", Jt, self.r)
+            held = ((self.x <= self.lower) & (self.g > 0.0)) | ((self.x >= self.upper) & (self.g < 0.0))
+            self.free = ~held
+            d = np.diag(self.A).copy()
+            self.d = np.maximum(d, 1e-12 * max(float(d.max()), 1e-300))
+            return
+        r_new = R[0]
+        self.nfev += 1
+        f_new = _sum_sq(r_new)
+        s = self.x_new - self.x  # type: ignore[operator]
+        predicted = -(2.0 * float(s @ self.g) + float(s @ self.A @ s))
+        actual = self.f - f_new
+        if actual > 0.0 and predicted > 0.0:
+            rho = actual / predicted
+            self.mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+            self.nu = 2.0
+            self.x, self.r, self.f = self.x_new, r_new, f_new
+            self.A = None  # the next request is a Jacobian at the new point
+            if actual < self.ftol * (self.f + actual) and predicted < self.ftol * (self.f + actual):
+                self._stop("ftol")
+            elif not self.nfev < self.max_nfev:
+                self._stop("budget")
+            return
+        self.mu *= self.nu
+        self.nu *= 2.0
+
+
+def levenberg_marquardt_many(
+    batch: Batch,
+    X0: NDArray[np.float64],
+    R0: NDArray[np.float64],
+    *,
+    step: float,
+    max_nfev: int,
+    lower: float = 0.0,
+    upper: float = 1.0,
+    ftol: float = 1e-8,
+    xtol: float = 1e-8,
+    mu0: float = 1e-3,
+    fill: NDArray[np.float64] | None = None,
+    on_round: Callable[[int, int], None] | None = None,
+) -> list[LmResult]:
+    """`levenberg_marquardt` from each row of X0 (R0: their residuals), in lockstep: every round
+    evaluates what each running descent needs next (a Jacobian's n rows or one trial point) in one
+    call of `batch`. Rows are independent, so each descent takes the path it takes alone; the
+    batch keeps both cores busy where a lone descent's trial points run one at a time.
+
+    `fill` (one value per descent, optional): what a residual that is not finite becomes in that
+    descent's rows (a trial point that diverges is then rejected), as a caller of
+    `levenberg_marquardt` does in its own `batch`. `on_round(stopped, total)` follows the rounds.
+    """
+    descents = [_Descent(x0, r0, step, max_nfev, lower, upper, ftol, xtol, mu0) for x0, r0 in zip(X0, R0, strict=True)]
+    while True:
+        wanted = [(j, d, d.rows()) for j, d in enumerate(descents)]
+        wanted = [(j, d, X) for j, d, X in wanted if X is not None]
+        if not wanted:
+            if on_round is not None:
+                on_round(len(descents), len(descents))
+            return [d.result for d in descents]  # type: ignore[misc]
+        R = batch(np.concatenate([X for _, _, X in wanted]))
+        at = 0
+        for j, d, X in wanted:
+            part = R[at : at + len(X)]
+            d.take(part if fill is None else np.where(np.isfinite(part), part, fill[j]))
+            at += len(X)
+        if on_round is not None:
+            on_round(sum(d.result is not None for d in descents), len(descents))
 
 
 def levenberg_marquardt(
@@ -79,46 +194,7 @@ def levenberg_marquardt(
     less than `ftol`·f while predicting no more, when a step is below `xtol`·(xtol + |x|), or
     after `max_nfev` trial points.
     """
-    x = np.clip(np.asarray(x0, dtype=np.float64), lower, upper)
-    r = np.asarray(r0, dtype=np.float64)
-    f = _sum_sq(r)
-    mu, nu, nfev, njev = mu0, 2.0, 0, 0
-    while nfev < max_nfev:
-        Jt = _jacobian(batch, x, r, step, upper)
-        njev += 1
-        # einsum, not BLAS: the same sums in the same order whatever BLAS's threads (a 1e-16
-        # difference flips an accept/reject near the end and moves the path: review of issue 36)
-        A, g = np.einsum("ik,jk->ij", Jt, Jt), np.einsum("ik,k->i", Jt, r)
-        held = ((x <= lower) & (g > 0.0)) | ((x >= upper) & (g < 0.0))
-        free = ~held
-        d = np.diag(A).copy()
-        d = np.maximum(d, 1e-12 * max(float(d.max()), 1e-300))
-        while True:
-            if nfev >= max_nfev:
-                return LmResult(x, f, nfev, njev, "budget")
-            delta = np.zeros_like(x)
-            Af = A[np.ix_(free, free)] + mu * np.diag(d[free])
-            try:
-                delta[free] = np.linalg.solve(Af, -g[free])
-            except np.linalg.LinAlgError:
-                return LmResult(x, f, nfev, njev, "singular")
-            x_new = np.clip(x + delta, lower, upper)
-            s = x_new - x
-            if np.linalg.norm(s) <= xtol * (xtol + np.linalg.norm(x)):
-                return LmResult(x, f, nfev, njev, "xtol")
-            r_new = batch(x_new[None, :])[0]
-            nfev += 1
-            f_new = _sum_sq(r_new)
-            predicted = -(2.0 * float(s @ g) + float(s @ A @ s))
-            actual = f - f_new
-            if actual > 0.0 and predicted > 0.0:
-                rho = actual / predicted
-                mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
-                nu = 2.0
-                x, r, f = x_new, r_new, f_new
-                break
-            mu *= nu
-            nu *= 2.0
-        if actual < ftol * (f + actual) and predicted < ftol * (f + actual):
-            return LmResult(x, f, nfev, njev, "ftol")
-    return LmResult(x, f, nfev, njev, "budget")
+    return levenberg_marquardt_many(
+        batch, np.asarray(x0, dtype=np.float64)[None, :], np.asarray(r0, dtype=np.float64)[None, :], step=step,
+        max_nfev=max_nfev, lower=lower, upper=upper, ftol=ftol, xtol=xtol, mu0=mu0,
+    )[0]  # fmt: skip

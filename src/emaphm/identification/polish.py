@@ -2,10 +2,11 @@
 
 `polish_stage` refines the best point with a small CMA-ES (`polish`) and its distinct runner-ups
 from the final population by least squares on eq. 3's residual vector (`candidates`,
-`polish_runner_ups`, `lm_polish`: bounded Levenberg–Marquardt, `lm`), and keeps the best; after
-the final checks (`checks`), `least_squares_stage` ends the search with scipy's bounded least
-squares on the same residuals (`least_squares_polish`), its Jacobian one batch per iteration. Both
-run only with the settings' ``polish``.
+`polish_runner_ups`: bounded Levenberg–Marquardt descents in lockstep, `descents`), and keeps
+the best; after the final checks (`checks`), `least_squares_stage` ends the search with scipy's
+bounded least squares on the same residuals (`least_squares_polish`), its Jacobian one batch per
+iteration. Both run only with the settings' ``polish``; after the multistart search (whose
+points are least-squares end points) the first does nothing.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .context import Context
-from .lm import levenberg_marquardt
+from .descents import lm_polish_many
 from .metrics import wrap_phase
 from .optimizers import (
     BatchProblem,
@@ -35,7 +36,6 @@ __all__ = [
     "candidates",
     "least_squares_polish",
     "least_squares_stage",
-    "lm_polish",
     "polish",
     "polish_runner_ups",
     "polish_stage",
@@ -161,31 +161,6 @@ def least_squares_polish(
     return counted.kept(start, np.asarray(res.x, dtype=np.float64), 2.0 * float(res.cost))
 
 
-def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
-    """`least_squares_polish`'s job by bounded Levenberg–Marquardt on the 8 × 8 normal equations
-    (`lm.levenberg_marquardt`): the runner-ups' polish (`polish_runner_ups`).
-
-    The same residuals, Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`); it
-    keeps the start if it does not improve on it. scipy's trust-region method works on the
-    10⁴ × 8 Jacobian itself and pays for it on every call (`lm`'s docstring); the search's last
-    polish and the last stage keep it, whose estimates the interval and detection calibrations
-    were fitted to (a Levenberg–Marquardt there moved the final %err by +0.08 ± 0.05 on 80 paired
-    runs, BENCHMARKS.md, issue 36).
-    """
-    x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
-    counted = CountedResiduals(residuals, x0)
-    if not np.all(np.isfinite(counted.r0)):
-        return counted.kept(start)
-    try:
-        res = levenberg_marquardt(
-            lambda X: counted.finite(counted.batch(X)), x0, counted.r0, step=limits.LS_STEP,
-            max_nfev=limits.LS_MAX_NFEV,
-        )  # fmt: skip
-    except (ValueError, np.linalg.LinAlgError):
-        return counted.kept(start)
-    return counted.kept(start, res.x, res.f)
-
-
 def candidates(run: OptimizerRun, count: int | None = None, distance: float | None = None) -> list[OptimizerRun]:
     """The run's best point and up to `count` − 1 members of its final population (default
     `limits.POLISH_CANDIDATES`), best first, each more than `distance` (default
@@ -218,14 +193,14 @@ def candidates(run: OptimizerRun, count: int | None = None, distance: float | No
 
 def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: OptimizerRun, kept: OptimizerRun,
                       count: int | None = None) -> tuple[OptimizerRun, int]:  # fmt: skip
-    """The least-squares polish (`lm_polish`) of the search's distinct runner-ups (`candidates`
-    but its best point), each from the representative of k7 inside the box (`recentre_phase`: a
-    polish cannot move a point at a bound), against `kept`, the polished best point: the best of
-    them, its value the search's own (`evaluate`, one evaluation), and which runner-up gave it (0:
-    `kept` stands). Evaluations: `kept`'s and all of theirs."""
+    """The least-squares polish (`descents.lm_polish_many`: in lockstep) of the search's distinct
+    runner-ups (`candidates` but its best point), each from the representative of k7 inside the
+    box (`recentre_phase`: a polish cannot move a point at a bound), against `kept`, the polished
+    best point: the best of them, its value the search's own (`evaluate`, one evaluation), and
+    which runner-up gave it (0: `kept` stands). Evaluations: `kept`'s and all of theirs."""
     evaluations, best, won = kept.evaluations, None, 0
-    for i, start in enumerate(candidates(search, count)[1:], start=1):
-        polished = lm_polish(residuals, recentre_phase(OptimizerRun(start.x, start.f, 0, [])))
+    starts = [recentre_phase(OptimizerRun(start.x, start.f, 0, [])) for start in candidates(search, count)[1:]]
+    for i, polished in enumerate(lm_polish_many(residuals, starts), start=1):
         evaluations += polished.evaluations
         if polished.f < kept.f and (best is None or polished.f < best.f):
             best, won = polished, i
@@ -239,7 +214,8 @@ def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: Optimiz
 
 def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
     """Stage 2: the CMA-ES polish of the search's best point (`polish`), then the least-squares
-    polish of its distinct runner-ups (`polish_runner_ups`); the best kept.
+    polish of its distinct runner-ups (`polish_runner_ups`); the best kept. Not after the
+    multistart search, whose points are least-squares end points (`multistart`).
 
     Until issue 36 the best runner-up got a CMA-ES polish of its own (up to 1569 evaluations);
     least squares from up to four of them costs 60–130 LF runs each. Least squares does not
@@ -251,6 +227,10 @@ def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
     assert state is not None  # the search ran
     if not context.settings.polish:
         return state, {"stage": "polish", "ran": False}
+    if context.settings.optimizer == "multistart":
+        # its points are least-squares end points already; a CMA-ES from the best moved the %err
+        # by +0.02 ± 0.02 on 77 paired random runs (BENCHMARKS.md, issue 36)
+        return state, {"stage": "polish", "ran": False, "reason": "the multistart search ends in least squares"}
     search = state.run
     best = polish(context.evaluate, recentre_phase(search), seed=context.seed, on_generation=context.on_generation)
     run, won = polish_runner_ups(context.residuals(), context.evaluate, search, best)

@@ -16,11 +16,13 @@ from ..faults import as_fault_vector
 from . import checks, limits, polish
 from .context import Context
 from .gwo import grey_wolf
+from .multistart import multistart
 from .optimizers import (
     BatchProblem,
     Objective,
     OnGeneration,
     OptimizerRun,
+    Residuals,
     Stagnation,
     check_optimizer,
     run_pymoo,
@@ -41,10 +43,13 @@ def run_optimizer(
     seed: int = 0,
     stagnation: Stagnation | None = None,
     on_generation: OnGeneration | None = None,
+    residuals: Residuals | None = None,
 ) -> OptimizerRun:
     """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`).
 
-    Stops at `generations` or when `stagnation` (default `Stagnation()`) says so.
+    Stops at `generations` or when `stagnation` (default `Stagnation()`) says so. "multistart"
+    (`multistart.multistart`) needs `residuals` too (rows → residual vectors, Σ r² = `evaluate`);
+    its population is its sample and its generations its least-squares descents.
     """
     check_optimizer(name)
     default_pop, default_gen = limits.DEFAULT_BUDGETS[name]
@@ -54,6 +59,11 @@ def run_optimizer(
         raise InputError(
             f"need a population of at least 4 and 1 generation, got {pop_size} and {generations}"
         )
+    if name == "multistart":
+        if residuals is None:
+            raise InputError("the multistart search needs the residuals of its objective")
+        return multistart(evaluate, residuals, n_var=n_var, sample=pop_size, descents=generations, seed=seed,
+                          on_generation=on_generation)  # fmt: skip
     stop = stagnation if stagnation is not None else Stagnation()
     rng = np.random.default_rng(seed)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
@@ -90,12 +100,13 @@ def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng
 
 
 def global_search(state: State | None, context: Context) -> tuple[State, Record]:
-    """Stage 1: the settings' optimiser over the box [0, 1]^8 (`optimizers.run_optimizer`), one
-    parallel monitor call per generation, from the context's seed."""
+    """Stage 1: the settings' optimiser over the box [0, 1]^8 (`run_optimizer`), one parallel
+    monitor call per generation (multistart: per round of its descents), from the context's seed."""
     s = context.settings
     run = run_optimizer(
         s.optimizer, context.evaluate, pop_size=s.pop_size, generations=s.generations, seed=context.seed,
         stagnation=Stagnation(s.patience, s.rtol), on_generation=context.on_generation,
+        residuals=context.residuals() if s.optimizer == "multistart" else None,
     )  # fmt: skip
     return State(run), {
         "stage": "search", "optimizer": s.optimizer, "seed": context.seed, "generations_run": len(run.history),

@@ -21,7 +21,7 @@ from typing import Any
 from ..choices import LAST_STAGES, MONITORS, OPTIMIZERS, SLOPE_UNITS, UQ_METHODS
 from ..errors import InputError
 
-__all__ = ["IdentifySettings", "parse_error_corner"]
+__all__ = ["IdentifySettings", "budget_text", "parse_error_corner", "search_progress_label"]
 
 MAX_SEED = 2**63 - 1
 
@@ -40,15 +40,18 @@ class IdentifySettings:
 
     Parameters
     ----------
-    optimizer : {"ga", "de", "pso", "cmaes", "gwo"}
-        The global search (the paper's GA by default; `identification.search`).
+    optimizer : {"ga", "de", "pso", "cmaes", "gwo", "multistart"}
+        The global search (the paper's GA by default; `identification.search`). "multistart"
+        (`identification.multistart`): a Latin-hypercube sample and least-squares descents from
+        its best points, a third of the monitor runs but less robust (screening).
     seed : int
         The user's seed, 0..2^63 − 1: `emaphm.identify` splits it into the twin's noise seed and
         the optimiser's; `FaultIdentifier` uses it as the optimiser's.
     workers : int
         numba threads of the population kernel (0: all cores).
     pop_size, generations : int or None
-        The search's budget (None: the optimiser's default, `limits.DEFAULT_BUDGETS`).
+        The search's budget (None: the optimiser's default, `limits.DEFAULT_BUDGETS`); for
+        "multistart" its sample size and its number of descents.
     patience, rtol
         Early stop when the best fitness improves by less than `rtol` (relative) over `patience`
         generations.
@@ -72,11 +75,16 @@ class IdentifySettings:
         The 90 % interval of each fault (`identification.uncertainty`).
     """
 
-    optimizer: str = _option("ga", "ga, de, pso, cmaes or gwo.", choices=OPTIMIZERS)
+    optimizer: str = _option(
+        "ga",
+        "ga (default), de, pso, cmaes, gwo, or multistart: least squares from a sample, a third of the "
+        "monitor runs but less robust, for screening (docs/identification.md).",
+        choices=OPTIMIZERS,
+    )
     seed: int = _option(0, "Seed of the optimiser (and of the twin's noise).")
     workers: int = _option(0, "Threads for the population kernel (0: all cores).")
-    pop_size: int | None = _option(None, "Population size (default per optimiser).")
-    generations: int | None = _option(None, "Maximum generations (default per optimiser).")
+    pop_size: int | None = _option(None, "Population size (default per optimiser; multistart: its sample).")
+    generations: int | None = _option(None, "Maximum generations (default per optimiser; multistart: its descents).")
     patience: int = _option(25, "Stop after this many generations without gain.", cli=False)
     rtol: float = _option(1e-3, "The relative gain that counts for --patience.", cli=False)
     polish: bool = _option(True, "Local polish of the best point.", flag="--polish/--no-polish")
@@ -199,3 +207,22 @@ def parse_error_corner(value: Any, name: str = "the error corner") -> float | st
     if not (math.isfinite(hz) and hz > 0):
         raise InputError(f"{name} must be 'auto', 'off' or a frequency > 0 Hz, got {value!r}")
     return hz
+
+
+def search_progress_label(optimizer: str) -> str:
+    """What a progress bar counts during the search: the multistart's least-squares descents, the
+    other optimisers' generations."""
+    return "least-squares descents" if optimizer == "multistart" else f"{optimizer.upper()} generations"
+
+
+def budget_text(optimizer: str, pop_size: int | None, generations: int | None) -> str:
+    """The search's budget in words (None: the optimiser's default, `limits.DEFAULT_BUDGETS`)."""
+    from .limits import DEFAULT_BUDGETS
+
+    default_pop, default_gen = DEFAULT_BUDGETS.get(optimizer, (None, None))
+    pop = default_pop if pop_size is None else pop_size
+    gen = default_gen if generations is None else generations
+    if optimizer == "multistart":
+        return f"a sample of {pop} points, {gen} least-squares descents"
+    return f"{pop} × {gen} generations"
+

@@ -265,3 +265,31 @@ def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out):  # type: i
         out[r] = fit_0
         if pair:
             out[r + 1] = fit_1
+
+
+@jit(parallel=True)
+def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out):  # type: ignore[no-untyped-def]
+    """eq. (3)'s residual vector of one LF run per row of `prm` into out (n_runs, len(keep)), in
+    parallel: out[r] = root_w·(ref_keep − sosfiltfilt(sos, simulate_lf(row))[keep]).
+
+    The least squares' view of `fitness_lf_many` (Σ out[r]² is its eq. 3 to rounding): the same
+    runs and filter, rows in interleaved pairs, the same numbers as filtering the currents of
+    `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
+    LF current is not finite gets NaN residuals.
+    """
+    n = theta_cmd.shape[0]
+    n_runs = prm.shape[0]
+    no_aux = np.empty((0, N_AUX))
+    for q in prange((n_runs + 1) // 2):
+        r = 2 * q
+        pair = r + 1 < n_runs
+        buf = np.zeros((2, n + 2 * pad))
+        simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
+        if pair:
+            simulate_lf(theta_cmd, prm[r + 1], buf[1, pad : pad + n], no_aux)
+        sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+        for j in range(keep.shape[0]):
+            out[r, j] = root_w[j] * (ref_keep[j] - buf[0, pad + keep[j]])
+        if pair:
+            for j in range(keep.shape[0]):
+                out[r + 1, j] = root_w[j] * (ref_keep[j] - buf[1, pad + keep[j]])
