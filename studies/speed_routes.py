@@ -10,7 +10,10 @@ basins, wall time per identification) with one route applied in this process:
   least-squares polish, the switching last stage);
 - ``lm-only``: the polish stage without its CMA-ES (least squares of the candidates alone);
 - ``cmaes-only``: the polish stage as the CMA-ES of the best point alone: with
-  ``--optimizer multistart`` (whose own polish stage does nothing) a CMA-ES after its descents.
+  ``--optimizer multistart`` (whose own polish stage does nothing) a CMA-ES after its descents;
+- ``descents``: the polish stage as eight least-squares descents from the search's best point
+  and its best population members 0.1 apart (`descents.descend_from`), no CMA-ES: with
+  ``--generations 20`` the "GA 96 x 20 + descents" of BENCHMARKS.md, issue 36.
 
 With ``--pop-size`` / ``--generations`` (bench_multifault's) the GA's budget changes too. The
 routes measured before issue 36's change (the two CMA-ES polishes, smaller ones, none) ran at
@@ -26,7 +29,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROUTES = ("default", "lm-only", "cmaes-only")
+ROUTES = ("default", "lm-only", "cmaes-only", "descents")
 
 
 def lm_only_stage(state, context):  # type: ignore[no-untyped-def]
@@ -56,6 +59,20 @@ def cmaes_only_stage(state, context):  # type: ignore[no-untyped-def]
     return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": False, "candidate": 0, "fitness": run.f}
 
 
+def descents_stage(state, context):  # type: ignore[no-untyped-def]
+    """The polish stage as eight descents from the search's distinct best points (0.1 apart)."""
+    from emaphm.identification.descents import descend_from
+    from emaphm.identification.optimizers import OptimizerRun
+
+    if not context.settings.polish:
+        return state, {"stage": "polish", "ran": False}
+    search = state.run
+    end, start = descend_from(search, context.residuals(), context.evaluate, 8, 0.1)
+    if not end.f < search.f:  # the search's point stands, the descents' evaluations counted
+        end, start = OptimizerRun(search.x, search.f, end.evaluations, search.history), -1
+    return state.with_run(end), {"stage": "polish", "ran": True, "candidate": start, "fitness": end.f}
+
+
 def apply(route: str) -> None:
     from emaphm.identification import polish, search
 
@@ -66,6 +83,8 @@ def apply(route: str) -> None:
         swap(polish.polish_stage, lm_only_stage)
     elif route == "cmaes-only":
         swap(polish.polish_stage, cmaes_only_stage)
+    elif route == "descents":
+        swap(polish.polish_stage, descents_stage)
     elif route != "default":
         raise SystemExit(f"unknown route {route!r}; one of {', '.join(ROUTES)}")
 

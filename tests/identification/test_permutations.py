@@ -97,7 +97,7 @@ def two_basins_residuals(X):
 
 
 def test_the_candidates_are_the_best_members_of_other_basins():
-    from emaphm.identification.polish import candidates
+    from emaphm.identification.descents import candidates
 
     close = A + 0.01  # the same basin: within RUNNER_UP_DISTANCE in every fault
     same_phase = A.copy()
@@ -130,3 +130,19 @@ def test_polishing_the_runner_ups_escapes_a_neighbouring_basin():
     swapped = OptimizerRun(B.copy(), 0.0, 10, [0.0], population[::-1], two_basins(population[::-1]))
     stays, won = polish_runner_ups(two_basins_residuals, two_basins, swapped, swapped, 5)
     assert won == 0 and stays.f == 0.0 and np.array_equal(stays.x, B)
+
+
+def test_descents_from_the_candidates_escape_a_neighbouring_basin():
+    from emaphm.identification.descents import descend_from
+
+    population = np.array([A, A - 0.01, B + 0.05])
+    run = OptimizerRun(A.copy(), float(two_basins(A)[0]), 10, [1.0], population, two_basins(population))
+    out, start = descend_from(run, two_basins_residuals, two_basins, 5, 0.05)
+    assert start == 1 and out.f < 1e-8 and np.max(np.abs(out.x - B)) < 1e-4
+    # two descents (A − 0.01 is within 0.05 of A): their end points and values are the population
+    assert out.population.shape == (2, 8) and abs(out.population_f[0] - 0.05) < 1e-8
+    assert out.evaluations > 10 + 2 * 9 and out.history == [1.0, out.f]  # the run's, all evaluations
+    # when the best point's basin is the deep one, its descent wins
+    swapped = OptimizerRun(B.copy(), 0.0, 10, [0.0], population[::-1], two_basins(population[::-1]))
+    stays, start = descend_from(swapped, two_basins_residuals, two_basins, 5, 0.05)
+    assert start == 0 and stays.f == 0.0 and np.array_equal(stays.x, B)

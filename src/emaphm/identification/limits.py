@@ -99,7 +99,7 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "multistart": (256, 8),
 }
 # the multistart's descents start from sample points this far apart in some fault (max norm over
-# k1..k8, k7 on the circle; `polish.candidates`)
+# k1..k8, k7 on the circle; `descents.candidates`)
 MULTISTART_DISTANCE = 0.1
 
 # ---- the polish (`polish`) ----

@@ -1,10 +1,11 @@
 """Stage 1 by least squares from many starts (the search "multistart", issue 36).
 
 A Latin-hypercube sample of the box [0, 1]^8 (`latin_hypercube`, from the run's seed) is evaluated
-in one batch of eq. 3; from its best points that are distinct in some fault (`polish.candidates`,
-`limits.MULTISTART_DISTANCE` apart) bounded Levenberg–Marquardt descents (`descents.lm_polish_many`) run in lockstep,
-one batch of monitor runs per round; the best end point is the search's. The run's population
-is the descents' end points, already polished, which the polish stage then leaves as they are.
+in one batch of eq. 3; from its best points that are distinct in some fault (`descents.candidates`,
+`limits.MULTISTART_DISTANCE` apart) bounded Levenberg–Marquardt descents run in lockstep
+(`descents.descend_from`), one batch of monitor runs per round; the best end point is the
+search's. The run's population is the descents' end points, already polished, which the polish
+stage then leaves as they are.
 
 Why, and why not the default (BENCHMARKS.md, issue 36): eq. 3 over a 10⁴-sample residual is
 smooth enough that a descent from a coarse start usually reaches the basin the GA finds. On 200
@@ -22,10 +23,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import limits
-from .descents import lm_polish_many
+from .descents import descend_from
 from .optimizers import Objective, OnGeneration, OptimizerRun, Residuals
-from .polish import candidates
-from .problem import recentre_phase
 
 __all__ = ["latin_hypercube", "multistart"]
 
@@ -62,21 +61,14 @@ def multistart(
     rng = np.random.default_rng(seed)
     X = latin_hypercube(sample, n_var, rng)
     f = _finite(evaluate(X))
-    best = int(np.argmin(f))
-    first = OptimizerRun(X[best], float(f[best]), sample, [float(f[best])], X, f)
-    starts = [recentre_phase(OptimizerRun(run.x, run.f, 0, []))
-              for run in candidates(first, descents, limits.MULTISTART_DISTANCE)]  # fmt: skip
+    b = int(np.argmin(f))
+    first = OptimizerRun(X[b], float(f[b]), sample, [float(f[b])], X, f)
 
     def report(done: int, total: int) -> None:
         if on_generation is not None:
             on_generation(done, total, first.f)
 
-    ends = lm_polish_many(residuals, starts, on_round=report)
-    P = np.array([end.x for end in ends])
-    F = _finite(evaluate(P))
-    k = int(np.argmin(F))
-    evaluations = sample + sum(end.evaluations for end in ends) + len(P)
-    return OptimizerRun(P[k], float(F[k]), evaluations, [first.f, float(F[k])], P, F)
+    return descend_from(first, residuals, evaluate, descents, limits.MULTISTART_DISTANCE, on_round=report)[0]
 
 
 def _finite(f: NDArray[np.float64]) -> NDArray[np.float64]:

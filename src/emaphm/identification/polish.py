@@ -17,8 +17,7 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .context import Context
-from .descents import lm_polish_many
-from .metrics import wrap_phase
+from .descents import candidates, lm_polish_many
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -28,12 +27,11 @@ from .optimizers import (
     Stagnation,
     minimize_batch,
 )
-from .problem import recentre_phase, search_to_faults
+from .problem import recentre_phase
 from .state import Record, State
 
 __all__ = [
     "CountedResiduals",
-    "candidates",
     "least_squares_polish",
     "least_squares_stage",
     "polish",
@@ -159,36 +157,6 @@ def least_squares_polish(
     except (ValueError, np.linalg.LinAlgError):
         return counted.kept(start)
     return counted.kept(start, np.asarray(res.x, dtype=np.float64), 2.0 * float(res.cost))
-
-
-def candidates(run: OptimizerRun, count: int | None = None, distance: float | None = None) -> list[OptimizerRun]:
-    """The run's best point and up to `count` − 1 members of its final population (default
-    `limits.POLISH_CANDIDATES`), best first, each more than `distance` (default
-    `limits.RUNNER_UP_DISTANCE`) from every one taken before in some fault (max norm over k1..k8
-    in fault space, k7's difference on the circle); only the best point without a population.
-
-    The GA's final population is still spread (70-95 of 96 members that far on the benchmark
-    cases): a basin next to the one the best point fell in is often held by a member. Polishing the
-    best such runner-up too turned the one wrong basin of the 40 x 2 benchmark runs (case 17 seed
-    2: 1.25 x the best fitness known, 4.25 %err) into the best basin (1.46 %err).
-    """
-    count = limits.POLISH_CANDIDATES if count is None else count
-    distance = limits.RUNNER_UP_DISTANCE if distance is None else distance
-    chosen = [run]
-    if run.population is None or run.population_f is None or not len(run.population) or count < 2:
-        return chosen
-    K = search_to_faults(run.population)
-    taken = [search_to_faults(run.x[None, :])[0]]
-    f = np.where(np.isfinite(run.population_f), run.population_f, np.inf)
-    for j in np.argsort(f, kind="stable"):
-        if len(chosen) >= count or not np.isfinite(f[j]):
-            break
-        d = np.abs(K[j] - np.asarray(taken))
-        d[:, 6] = np.abs(wrap_phase(d[:, 6]))
-        if np.all(d.max(axis=1) > distance):
-            chosen.append(OptimizerRun(run.population[j].copy(), float(f[j]), 0, []))
-            taken.append(K[j])
-    return chosen
 
 
 def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: OptimizerRun, kept: OptimizerRun,
