@@ -180,3 +180,13 @@ def test_fault_identifier_takes_the_monitor_by_name_or_as_a_model():
     assert FaultIdentifier(IdentifySettings(monitor="paper")).monitor is None  # built from the name
     with pytest.raises(InputError, match="monitor 'paper' was asked for, the MonitorEma given is 'default'"):
         FaultIdentifier(IdentifySettings(monitor="paper"), monitor=MonitorEma())
+
+
+def test_the_budget_and_the_progress_in_words():
+    from emaphm.identification.settings import budget_text, search_progress_label
+
+    assert budget_text("ga", None, None) == "96 × 40 generations"  # the optimiser's default
+    assert budget_text("ga", 16, 3) == "16 × 3 generations"
+    assert budget_text("multistart", None, 4) == "a sample of 256 points, 4 least-squares descents"
+    assert search_progress_label("multistart") == "least-squares descents"
+    assert search_progress_label("de") == "DE generations"

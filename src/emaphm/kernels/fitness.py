@@ -240,6 +240,22 @@ def filtered_fitness(e, f, pad, sos, zi, ref, weights):  # type: ignore[no-untyp
     return fit_e, fit_f
 
 
+@jit
+def simulate_pair(theta_cmd, prm, r, pair, pad):  # type: ignore[no-untyped-def]
+    """LF runs of rows r and, with `pair`, r + 1 of `prm` into a new buffer of 2 rows of
+    len(theta_cmd) + 2·pad samples, each current at [pad, pad + n) (the pads are the filter's to
+    fill); without `pair` the second row is zeros (a partner for the interleaved filter)."""
+    n = theta_cmd.shape[0]
+    no_aux = np.empty((0, N_AUX))
+    buf = np.empty((2, n + 2 * pad))
+    simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
+    if pair:
+        simulate_lf(theta_cmd, prm[r + 1], buf[1, pad : pad + n], no_aux)
+    else:
+        buf[1, :] = 0.0
+    return buf
+
+
 @jit(parallel=True)
 def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out):  # type: ignore[no-untyped-def]
     """eq. (3) of one LF run per row of `prm` (shape (n_runs, N_FIELDS)) into out (n_runs,), in parallel.
@@ -249,18 +265,11 @@ def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out):  # type: i
     pairs (rows 2q and 2q + 1 on one thread) whose filters run interleaved; with an odd number of
     rows the last one is paired with a zero signal.
     """
-    n = theta_cmd.shape[0]
     n_runs = prm.shape[0]
-    no_aux = np.empty((0, N_AUX))
     for q in prange((n_runs + 1) // 2):
         r = 2 * q
         pair = r + 1 < n_runs
-        buf = np.empty((2, n + 2 * pad))
-        simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
-        if pair:
-            simulate_lf(theta_cmd, prm[r + 1], buf[1, pad : pad + n], no_aux)
-        else:
-            buf[1, :] = 0.0
+        buf = simulate_pair(theta_cmd, prm, r, pair, pad)
         fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
         out[r] = fit_0
         if pair:
@@ -277,16 +286,11 @@ def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out)
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
     LF current is not finite gets NaN residuals.
     """
-    n = theta_cmd.shape[0]
     n_runs = prm.shape[0]
-    no_aux = np.empty((0, N_AUX))
     for q in prange((n_runs + 1) // 2):
         r = 2 * q
         pair = r + 1 < n_runs
-        buf = np.zeros((2, n + 2 * pad))
-        simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
-        if pair:
-            simulate_lf(theta_cmd, prm[r + 1], buf[1, pad : pad + n], no_aux)
+        buf = simulate_pair(theta_cmd, prm, r, pair, pad)
         sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
         for j in range(keep.shape[0]):
             out[r, j] = root_w[j] * (ref_keep[j] - buf[0, pad + keep[j]])
