@@ -94,9 +94,8 @@ def current_scale(context: Context, faults: ArrayLike, present: list[str] | set[
     r_est = counted.r0
     if not np.all(np.isfinite(r_est)):
         return {}
-    weights = context.objective.weights
-    keep = np.flatnonzero(weights > 0)
-    ref = np.sqrt(weights[keep]) * context.objective.comparison.reference[keep]  # √w·I_ref
+    _, root_w, reference = context.objective.weighed()
+    ref = root_w * reference  # √w·I_ref on the samples of the residual vector
     held = [i for i in SHORTS if FAULT_NAMES[i] not in present]
     free = [i for i in range(len(k)) if i not in held]
 

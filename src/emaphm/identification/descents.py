@@ -19,7 +19,14 @@ from .metrics import wrap_phase
 from .optimizers import Objective, OptimizerRun, Residuals
 from .problem import recentre_phase, search_to_faults
 
-__all__ = ["candidates", "descend_from", "lm_polish", "lm_polish_many"]
+__all__ = ["candidates", "descend_from", "diverged_fill", "lm_polish", "lm_polish_many"]
+
+
+def diverged_fill(r0: NDArray[np.float64]) -> float:
+    """What a residual that is not finite becomes in a descent started where the residual is `r0`:
+    10³ × its largest (inf if `r0` itself is not finite), so that a trial point that diverges is
+    rejected and the descent goes on."""
+    return 1e3 * max(float(np.max(np.abs(r0))), 1e-12) if np.all(np.isfinite(r0)) else np.inf
 
 
 def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
@@ -51,8 +58,7 @@ def lm_polish_many(
     evaluations = np.ones(len(starts), dtype=int)  # each start's own residual
     ends: dict[int, tuple[NDArray[np.float64], float]] = {}
     if ok:
-        # a residual that is not finite becomes 10³ × its descent's largest at the start (`CountedResiduals`)
-        fill = np.array([1e3 * max(float(np.max(np.abs(R0[j]))), 1e-12) for j in ok])
+        fill = np.array([diverged_fill(R0[j]) for j in ok])
         try:
             results = levenberg_marquardt_many(
                 lambda X: np.asarray(residuals(X), dtype=np.float64), X0[ok], R0[ok], step=limits.LS_STEP,

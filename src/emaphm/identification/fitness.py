@@ -94,11 +94,16 @@ class Fitness:
         _, theta_cmd = monitor.sample_grid(duration)
         rows = monitor.rows(K)
         self._check_grid(len(theta_cmd))
-        keep = np.flatnonzero(self.weights > 0)
+        keep, root_w, reference = self.weighed()
         out = np.empty((rows.shape[0], len(keep)))
-        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, self.comparison.reference[keep],
-                          np.sqrt(self.weights[keep]), out)  # fmt: skip
+        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, reference, root_w, out)
         return out
+
+    def weighed(self) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
+        """The samples eq. (3) weighs (w > 0), their √w and the reference there: the residual
+        vector's layout (`residuals_of_monitor`, r = √w·(I_ref − I_LF) on these samples)."""
+        keep = np.flatnonzero(self.weights > 0)
+        return keep, np.sqrt(self.weights[keep]), self.comparison.reference[keep]
 
     def _check_grid(self, n: int) -> None:
         ref = self.comparison.reference

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .context import Context
-from .descents import candidates, lm_polish_many
+from .descents import candidates, diverged_fill, lm_polish_many
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -78,7 +78,7 @@ class CountedResiduals:
     def __init__(self, residuals: Residuals, x0: NDArray[np.float64]) -> None:
         self.residuals, self.evaluations = residuals, 0
         self.r0 = self.batch(x0[None, :])[0]
-        self.big = 1e3 * max(float(np.max(np.abs(self.r0))), 1e-12) if np.all(np.isfinite(self.r0)) else np.inf
+        self.big = diverged_fill(self.r0)
 
     def batch(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
         self.evaluations += len(X)

@@ -106,7 +106,7 @@ def global_search(state: State | None, context: Context) -> tuple[State, Record]
     run = run_optimizer(
         s.optimizer, context.evaluate, pop_size=s.pop_size, generations=s.generations, seed=context.seed,
         stagnation=Stagnation(s.patience, s.rtol), on_generation=context.on_generation,
-        residuals=context.residuals() if s.optimizer == "multistart" else None,
+        residuals=context.residuals(),
     )  # fmt: skip
     return State(run), {
         "stage": "search", "optimizer": s.optimizer, "seed": context.seed, "generations_run": len(run.history),
