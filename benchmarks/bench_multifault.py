@@ -64,7 +64,7 @@ from emaphm.identification import Comparison
 from emaphm.identification import nrmse as nrmse_of
 
 # the identification's settings this benchmark sets (flags made from `IdentifySettings`)
-SETTINGS = (*BUDGET, "optimizer", "monitor", "last_stage")
+SETTINGS = (*BUDGET, "optimizer", "start", "monitor", "last_stage")
 
 
 def fitness_at(trace: emaphm.SimResult, K: np.ndarray, monitor: emaphm.MonitorEma) -> np.ndarray:

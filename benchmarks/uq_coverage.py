@@ -43,7 +43,7 @@ from _cases import (  # benchmarks/ first on sys.path
 import emaphm
 from emaphm import FAULT_NAMES, HEALTHY
 
-SETTINGS = (*BUDGET, "optimizer")  # the identification's settings this benchmark sets
+SETTINGS = (*BUDGET, "optimizer", "start")  # the identification's settings this benchmark sets
 
 
 def main(argv: list[str] | None = None) -> None:

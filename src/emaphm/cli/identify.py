@@ -126,6 +126,7 @@ def identify(
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else search_progress_label(settings.optimizer), abs(gen), total
             ),
+            on_progress=update,
         )  # fmt: skip
     data = result.to_json()
     for warning in data["warnings"]:

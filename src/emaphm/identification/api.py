@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -51,6 +52,7 @@ def identify(
     on_generation: OnGeneration | None = None,
     actuator_id: str | None = None,
     baseline: str | os.PathLike[str] | None = None,
+    on_progress: Callable[[str, int, int], None] | None = None,
     **options: Any,
 ) -> IdentificationResult:
     """Identify the faults from `reference`, or from the HF twin run with `true_faults` (noise on).
@@ -66,6 +68,7 @@ def identify(
         files; default: the packaged ones); an LF calibration for other parameters is refused.
     thresholds : the detection thresholds ({} reports nothing; default: the shipped ones).
     on_generation : progress callback (gen, max_gen, best); a negative gen counts MCMC steps.
+    on_progress : progress callback (label, done, total) of the start table's build (`start_table`).
     actuator_id : the actuator's id (serial, tail position), recorded as ``settings["actuator_id"]``.
     baseline : a folder from `emaphm.baseline` (``emaphm baseline``): the actuator's own file,
         calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``.
@@ -82,9 +85,8 @@ def identify(
         signals = {**m.trace.signals, "i_q": m.trace.i_q / used["current_gain"]}
         m = replace(m, trace=SimResult(t=m.trace.t, signals=signals, metadata=m.trace.metadata))
     doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
-    ident = FaultIdentifier(
-        s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation, doubtful_nrmse=doubtful[0]
-    )
+    ident = FaultIdentifier(s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation,
+                            doubtful_nrmse=doubtful[0], on_progress=on_progress)  # fmt: skip
     with numba_threads(s.workers):
         ident.fit(m.trace.t, m.trace.i_q, m.command, m.theta_u)
     warnings = [
@@ -284,7 +286,8 @@ def _record(
         else {
             "source": _source(uq_calibration, "packaged", Factors),
             "created": factors.record.get("created"),
-            "calibrated": bool(factors.record),
+            # the intervals use it only when it was fitted with this monitor (`_intervals`)
+            "calibrated": bool(factors.record) and factors.matches(monitor.calibration),
         },
         "versions": versions(),
     }

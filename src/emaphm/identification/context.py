@@ -58,6 +58,8 @@ class Context:
     on_generation: OnGeneration | None = None
     # the NRMSE above which a fit is doubtful for this monitor (`verdict.fit_limit`; None: not known)
     doubtful_nrmse: float | None = None
+    # progress of work that is not a generation (label, done, total): the start table's build
+    on_progress: Callable[[str, int, int], None] | None = None
 
     def with_seed(self, seed: int) -> Context:
         """The same comparison searched from another optimiser seed (`second_search`)."""
@@ -146,6 +148,7 @@ def prepare(
     monitor: MonitorEma | None = None,
     on_generation: OnGeneration | None = None,
     doubtful_nrmse: float | None = None,
+    on_progress: Callable[[str, int, int], None] | None = None,
 ) -> Context:
     """Check the measurement i_q [A] at t [s] (under `command`, default the monitor's; `theta_u`
     [rad], the surface position if measured, tells the rests in holds) and set up the comparison."""
@@ -191,4 +194,5 @@ def prepare(
     return Context(
         settings, settings.seed, model, duration, reference, shown, mask, compared, float(1.0 - in_band.mean()),
         corner, Fitness(reference, settings.slope_unit, mask, emphasis), on_generation, doubtful_nrmse,
+        on_progress,
     )  # fmt: skip

@@ -16,19 +16,17 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.ndimage import maximum_filter1d
-
 from ..calibration import Calibration
 from ..commands import Command
 
-__all__ = ["COMMAND_TOLERANCE", "command_rate", "command_warnings"]
+__all__ = ["COMMAND_TOLERANCE", "command_rate", "command_warnings", "matches"]
 
 # the command may differ from the calibrated one by this fraction of its peak (sampling and
 # interpolation of a recorded command stay far below: ~1e-6 for a 10 Hz chirp at 3 kHz)
 COMMAND_TOLERANCE = 1e-3
 
 
-def _matches(
+def matches(
     times: NDArray[np.float64], theta: NDArray[np.float64], command: Command, step: float, h: float
 ) -> bool:
     """Whether θ_cmd is `command` over the trace's times within the command.
@@ -47,6 +45,8 @@ def _matches(
         peak = float(np.max(np.abs(expected)))
         allowed = np.full(len(expected), COMMAND_TOLERANCE * peak)
         if h > step and len(expected) > 2:
+            from scipy.ndimage import maximum_filter1d  # 0.2-0.5 s to import: only when needed
+
             curvature = np.zeros(len(expected))
             curvature[1:-1] = np.abs(np.diff(expected, 2)) / step**2
             window = 2 * math.ceil(h / step) + 1
@@ -88,7 +88,7 @@ def command_warnings(
         if span > float(command.duration) + step + 1e-9:
             continue
         h = 1.0 / source_rate if source_rate and source_rate > 0 else 0.0
-        if _matches(times, theta, command, step, h):
+        if matches(times, theta, command, step, h):
             return []
     return [
         f"the position command is none of those the monitor was calibrated on ({names}): "

@@ -14,6 +14,7 @@ Uncertainty (6, `uncertainty`) and the verdict (7, `verdict`) follow in `api.ide
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -53,6 +54,8 @@ class FaultIdentifier:
     doubtful_nrmse : float, optional
         The fit [-] above which the result is doubtful (`verdict.fit_limit`); the second search
         starts from it where it is below the monitor's trigger (`limits.SECOND_SEARCH_NRMSE`).
+    on_progress : callable(label, done, total), optional
+        Progress of work that is not a generation: the start table's build (`start_table`).
 
     After `prepare`: ``context_`` (`context.Context`) and, from it, ``monitor_``, ``duration_``
     [s], ``reference_``, ``whole_``, ``mask_``, ``compared_``, ``above_band_``,
@@ -71,6 +74,7 @@ class FaultIdentifier:
         monitor: MonitorEma | str | None = None,
         on_generation: OnGeneration | None = None,
         doubtful_nrmse: float | None = None,
+        on_progress: Callable[[str, int, int], None] | None = None,
         **options: Any,
     ) -> None:
         if isinstance(monitor, str):  # the monitor by name: the settings' field (docs/conventions.md)
@@ -83,6 +87,7 @@ class FaultIdentifier:
         self.monitor = monitor
         self.on_generation = on_generation
         self.doubtful_nrmse = doubtful_nrmse
+        self.on_progress = on_progress
 
     def prepare(
         self, t: ArrayLike, i_q: ArrayLike, command: Command | None = None, theta_u: ArrayLike | None = None
@@ -91,7 +96,8 @@ class FaultIdentifier:
         it first); `theta_u` [rad], the measured surface position at t if the trace has it,
         tells where the surface rests in a hold (`weights.moving_mask`)."""
         ctx = prepare(t, i_q, command, theta_u, settings=self.settings, monitor=self.monitor,
-                      on_generation=self.on_generation, doubtful_nrmse=self.doubtful_nrmse)  # fmt: skip
+                      on_generation=self.on_generation, doubtful_nrmse=self.doubtful_nrmse,
+                      on_progress=self.on_progress)  # fmt: skip
         self.context_: Context = ctx
         self.monitor_, self.duration_, self.reference_, self.whole_ = (
             ctx.monitor,

@@ -63,6 +63,7 @@ __all__ = [
     "SOKAL_C",
     "SWITCHING_ITERATIONS",
     "SWITCHING_STEP_FACTORS",
+    "TABLE_GENERATIONS",
     "TAIL_MARGIN_S",
     "TAU_RTOL",
     "WALKERS",
@@ -101,6 +102,8 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
 # the multistart's descents start from sample points this far apart in some fault (max norm over
 # k1..k8, k7 on the circle; `descents.candidates`)
 MULTISTART_DISTANCE = 0.1
+# the GA's generations from the start table's first population (`start_table`, issue 36; BENCHMARKS.md)
+TABLE_GENERATIONS = 15
 
 # ---- the polish (`polish`) ----
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish

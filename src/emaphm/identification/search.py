@@ -10,10 +10,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..faults import as_fault_vector
-from . import checks, limits, polish
+from . import checks, limits, polish, start_table
 from .context import Context
 from .gwo import grey_wolf
 from .multistart import multistart
@@ -44,8 +45,11 @@ def run_optimizer(
     stagnation: Stagnation | None = None,
     on_generation: OnGeneration | None = None,
     residuals: Residuals | None = None,
+    initial: NDArray[np.float64] | None = None,
 ) -> OptimizerRun:
     """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`).
+
+    `initial` (pop_size, n_var): the GA's first population (`start_table`; default uniform).
 
     Stops at `generations` or when `stagnation` (default `Stagnation()`) says so. "multistart"
     (`multistart.multistart`) needs `residuals` too (rows → residual vectors, Σ r² = `evaluate`);
@@ -64,13 +68,15 @@ def run_optimizer(
             raise InputError("the multistart search needs the residuals of its objective")
         return multistart(evaluate, residuals, n_var=n_var, sample=pop_size, descents=generations, seed=seed,
                           on_generation=on_generation)  # fmt: skip
+    if initial is not None and (name != "ga" or np.shape(initial) != (pop_size, n_var)):
+        raise InputError(f"a first population is the GA's, of {pop_size} x {n_var} points")
     stop = stagnation if stagnation is not None else Stagnation()
     rng = np.random.default_rng(seed)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     if name == "gwo":
         return grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
     x, f, history, res = run_pymoo(
-        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng), stop.termination(generations),
+        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng, initial), stop.termination(generations),
         generations, seed, on_generation,
     )  # fmt: skip
     pop = res.pop
@@ -78,11 +84,16 @@ def run_optimizer(
                         np.asarray(pop.get("F"), dtype=np.float64).reshape(-1))  # fmt: skip
 
 
-def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator) -> Any:
+def _pymoo_algorithm(
+    name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator,
+    initial: NDArray[np.float64] | None = None,
+) -> Any:  # fmt: skip
     if name == "ga":
         from pymoo.algorithms.soo.nonconvex.ga import GA
         from pymoo.operators.crossover.pcx import PCX
 
+        if initial is not None:  # pymoo takes an array as the first population
+            return GA(pop_size=pop_size, sampling=np.array(initial), crossover=PCX(eta=0.5, zeta=0.5))
         return GA(pop_size=pop_size, crossover=PCX(eta=0.5, zeta=0.5))
     if name == "de":
         from pymoo.algorithms.soo.nonconvex.de import DE
@@ -101,16 +112,27 @@ def _pymoo_algorithm(name: str, pop_size: int, generations: int, n_var: int, rng
 
 def global_search(state: State | None, context: Context) -> tuple[State, Record]:
     """Stage 1: the settings' optimiser over the box [0, 1]^8 (`run_optimizer`), one parallel
-    monitor call per generation (multistart: per round of its descents), from the context's seed."""
+    monitor call per generation (multistart: per round of its descents), from the context's seed.
+
+    The GA's first population comes from the start table where the settings' ``start`` says so
+    (`start_table.uses_table`), and it then runs `limits.TABLE_GENERATIONS` generations unless
+    the settings give them; the record says which start it took."""
     s = context.settings
+    initial, generations, started = None, s.generations, {"start": "random"}
+    theta_cmd = start_table.uses_table(context)
+    if theta_cmd is not None:
+        pop_size = limits.DEFAULT_BUDGETS["ga"][0] if s.pop_size is None else s.pop_size
+        initial, table = start_table.first_population(context, theta_cmd, pop_size, context.on_progress)
+        generations = limits.TABLE_GENERATIONS if s.generations is None else s.generations
+        started = {"start": "table", **table}
     run = run_optimizer(
-        s.optimizer, context.evaluate, pop_size=s.pop_size, generations=s.generations, seed=context.seed,
+        s.optimizer, context.evaluate, pop_size=s.pop_size, generations=generations, seed=context.seed,
         stagnation=Stagnation(s.patience, s.rtol), on_generation=context.on_generation,
-        residuals=context.residuals(),
+        residuals=context.residuals(), initial=initial,
     )  # fmt: skip
     return State(run), {
         "stage": "search", "optimizer": s.optimizer, "seed": context.seed, "generations_run": len(run.history),
-        "evaluations": run.evaluations, "fitness": run.f,
+        "evaluations": run.evaluations, "fitness": run.f, **started,
     }  # fmt: skip
 
 

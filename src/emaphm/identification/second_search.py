@@ -2,7 +2,8 @@
 
 It runs when the fit's NRMSE over the compared samples exceeds `limits.SECOND_SEARCH_NRMSE` of the
 monitor, or the actuator's doubtful limit when lower (`verdict.fit_limit`, `Context.doubtful_nrmse`), while the fit still explains the measurement (`limits.FIT_NRMSE_LIMIT`), with the
-settings' ``polish`` and ``second_search``; it searches from `second_seed` and the lower eq. 3
+settings' ``polish`` and ``second_search``; it searches from `second_seed` (and from a uniform
+population with the optimiser's full budget, whatever the first search's start) and the lower eq. 3
 fitness (the search's own measure) is kept. The kept state counts both searches' evaluations;
 its history is the kept search's.
 """
@@ -39,7 +40,12 @@ def second_search(state: State | None, context: Context) -> tuple[State, Record]
         return state, record
     first = state
     other_seed = second_seed(context.seed)
-    second, stages = search.run_search(context.with_seed(other_seed))
+    # from a uniform population with the full budget: the start table's rows were the first
+    # search's start, and a second look is worth most where they led astray
+    again = context.with_seed(other_seed)
+    if s.start != "random":
+        again = replace(again, settings=s.replace(start="random"))
+    second, stages = search.run_search(again)
     # the lower eq. 3 fitness decides, among fits that explain the measurement: a second search
     # whose LF run diverged is never taken
     won = bool(second.run.f < first.run.f and second.fit_nrmse <= limits.FIT_NRMSE_LIMIT)

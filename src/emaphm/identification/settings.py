@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..choices import LAST_STAGES, MONITORS, OPTIMIZERS, SLOPE_UNITS, UQ_METHODS
+from ..choices import LAST_STAGES, MONITORS, OPTIMIZERS, SLOPE_UNITS, STARTS, UQ_METHODS
 from ..errors import InputError
 
 __all__ = ["IdentifySettings", "budget_text", "parse_error_corner", "search_progress_label"]
@@ -44,6 +44,13 @@ class IdentifySettings:
         The global search (the paper's GA by default; `identification.search`). "multistart"
         (`identification.multistart`): a Latin-hypercube sample and least-squares descents from
         its best points, a third of the monitor runs but less robust (screening).
+    start : {"random", "table", "auto"}
+        The GA's first population: uniform ("random", the default and the paper's: 40
+        generations), or the best rows of a table of monitor runs kept per actuator, calibration
+        and command ("table"; `identification.start_table`; then `limits.TABLE_GENERATIONS`
+        generations by default; opt-in: its %err tail is heavier, BENCHMARKS.md). "auto": the
+        table for the built-in commands and for recordings of one of the calibration's commands;
+        uniform otherwise and for the other optimisers.
     seed : int
         The user's seed, 0..2^63 − 1: `emaphm.identify` splits it into the twin's noise seed and
         the optimiser's; `FaultIdentifier` uses it as the optimiser's.
@@ -80,6 +87,14 @@ class IdentifySettings:
         "ga (default), de, pso, cmaes, gwo, or multistart: least squares from a sample, a third of the "
         "monitor runs but less robust, for screening (docs/identification.md).",
         choices=OPTIMIZERS,
+    )
+    start: str = _option(
+        "random",
+        "The GA's first population: 'random' (default: uniform, 40 generations, the paper's), 'table' (the best "
+        "of 16 384 monitor runs kept per actuator, calibration and command, then 15 generations: 0.76x the time, "
+        "a heavier %err tail) or 'auto' (the table for built-in commands and recordings of a calibrated one; "
+        "docs/identification.md).",
+        choices=STARTS,
     )
     seed: int = _option(0, "Seed of the optimiser (and of the twin's noise).")
     workers: int = _option(0, "Threads for the population kernel (0: all cores).")
@@ -130,6 +145,8 @@ class IdentifySettings:
                     f"unknown {f.name} {value!r}; use one of {', '.join(choices)}"
                 )
         _check_int("seed", self.seed, 0, MAX_SEED, "a whole number in 0..2^63-1")
+        if self.start == "table" and self.optimizer != "ga":
+            raise InputError(f"start 'table' is the GA's first population; the {self.optimizer} search has none")
         if self.workers is None:  # the API's "all cores", as 0
             object.__setattr__(self, "workers", 0)
         _check_int("workers", self.workers, 0, 4096, "0 (all cores) or a number of threads")

@@ -1,0 +1,167 @@
+"""The GA's first population from a table of monitor runs (issue 36, `identification.start_table`)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import emaphm
+from emaphm.commands import SampledCommand, Steps
+from emaphm.errors import InputError
+from emaphm.identification import start_table
+from emaphm.identification.identifier import FaultIdentifier
+from emaphm.identification.problem import search_to_faults
+from emaphm.identification.settings import IdentifySettings
+
+K = np.array([0.3, 0.2, 0.0, 0.35, 0.1, 0.02, 0.3, 0.5])
+
+
+@pytest.fixture
+def small(monkeypatch, tmp_path):
+    """A table of 512 rows in a folder of the test's own (the shipped size is a tuned constant)."""
+    monkeypatch.setattr(start_table, "TABLE_ROWS", 512)
+    monkeypatch.setattr(start_table, "BUILD_BATCH", 128)
+    monkeypatch.setenv("EMAPHM_TABLE_DIR", str(tmp_path / "tables"))
+    monkeypatch.setattr(start_table, "_MEMORY", {})
+    return tmp_path / "tables"
+
+
+def _context(trace, command=None, **settings):
+    settings = {"start": "auto", **settings}
+    ident = FaultIdentifier(IdentifySettings(**settings)).prepare(trace.t, trace.i_q, command)
+    return ident.context_
+
+
+def test_the_ranking_is_eq3_between_the_measurement_and_each_stored_current(small, sim):
+    trace = sim(K, ideal=False)
+    ctx = _context(trace)
+    theta = start_table.table_command(ctx)
+    table = start_table.build_table(ctx, theta)
+    # brute force: eq. 3 on the table's samples, from the monitor's own filtered currents
+    rows = table.X[:64]
+    currents = ctx.reference.filtered(ctx.monitor.simulate_many(search_to_faults(rows), duration=ctx.duration))
+    w, ref = ctx.objective.weights[table.index], ctx.reference.reference[table.index]
+    d = ((ref - currents[:, table.index]) ** 2) @ w
+    np.testing.assert_allclose(table.T[:64], currents[:, table.index], atol=2e-3 * np.abs(currents).max())
+    sub = start_table.StartTable(rows, table.T[:64], table.index, table.key)
+    got = sub.ranked(ctx.reference.reference, ctx.objective.weights, 5)
+    np.testing.assert_array_equal(got, rows[np.argsort(d)[:5]])
+
+
+def test_the_table_puts_the_first_population_near_the_truth(small, sim):
+    trace = sim(K, ideal=False)
+    ctx = _context(trace)
+    table, built = start_table.start_table(ctx, start_table.table_command(ctx))
+    assert built
+    best = table.ranked(ctx.reference.reference, ctx.objective.weights, 16)
+    rng = np.random.default_rng(0)
+    uniform = rng.uniform(size=(16, 8))
+    # the ranked rows fit the measurement far better than uniform ones (eq. 3, by the monitor)
+    assert np.median(ctx.evaluate(best)) < 0.3 * np.median(ctx.evaluate(uniform))
+
+
+def test_a_table_is_kept_by_its_key_and_read_back_the_same(small, sim):
+    trace = sim(K, ideal=False)
+    ctx = _context(trace)
+    theta = start_table.table_command(ctx)
+    first, built = start_table.start_table(ctx, theta)
+    assert built and len(list(small.glob("*.npz"))) == 1
+    start_table._MEMORY.clear()
+    again, built_again = start_table.start_table(ctx, theta)
+    assert not built_again
+    np.testing.assert_array_equal(first.T, again.T)
+    np.testing.assert_array_equal(first.X, again.X)
+    # another actuator (its monitor's rows) is another table
+    base = emaphm.EmaParams()
+    params = dataclasses.replace(base, transmission=dataclasses.replace(base.transmission, F_S0=1.2 * base.transmission.F_S0))
+    other = FaultIdentifier(IdentifySettings(), monitor=emaphm.MonitorEma(params, allow_mismatch=True)).prepare(
+        trace.t, trace.i_q).context_  # fmt: skip
+    assert start_table.table_key(other, theta) != first.key
+    # a file with another key at that name (a collision, a foreign file) is not taken
+    path = next(small.glob("*.npz"))
+    np.savez(path.open("wb"), X=first.X, T=first.T, index=first.index, key=np.array("x" * 64))
+    start_table._MEMORY.clear()
+    assert start_table.start_table(ctx, theta)[1]
+
+
+def test_a_folder_that_cannot_be_written_builds_the_table_in_memory(small, sim, monkeypatch, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv("EMAPHM_TABLE_DIR", str(blocker / "tables"))
+    ctx = _context(sim(K, ideal=False))
+    table, built = start_table.start_table(ctx, start_table.table_command(ctx))
+    assert built and len(table.X) > 0
+    assert start_table.start_table(ctx, start_table.table_command(ctx))[1] is False  # this process's
+
+
+def test_a_recording_of_the_chirp_shares_the_chirps_table_and_another_command_has_none(small, sim):
+    trace = sim(K, ideal=False)
+    chirp_ctx = _context(trace)
+    recorded = _context(trace, SampledCommand(trace.t - trace.t[0], trace.theta_cmd))
+    assert isinstance(recorded.monitor.command, SampledCommand)
+    theta = start_table.uses_table(recorded)
+    assert theta is not None
+    np.testing.assert_array_equal(theta, start_table.table_command(chirp_ctx))
+    # a command none of the calibration's: a uniform start with "auto", its own table with "table"
+    odd = SampledCommand(trace.t - trace.t[0], 0.5 * trace.theta_cmd)
+    assert start_table.uses_table(_context(trace, odd)) is None
+    own = start_table.uses_table(_context(trace, odd, start="table"))
+    np.testing.assert_allclose(own, 0.5 * np.asarray(start_table.table_command(chirp_ctx)), atol=1e-12)
+    assert start_table.uses_table(_context(trace, start="random")) is None
+    assert start_table.uses_table(_context(trace, optimizer="de")) is None
+    steps = sim(K, command=Steps(), ideal=False)
+    steps_ctx = _context(steps, Steps())
+    t, theta = steps_ctx.monitor.sample_grid(steps_ctx.duration)
+    np.testing.assert_array_equal(start_table.uses_table(steps_ctx), theta)  # a built-in command's own
+
+
+def test_an_identification_records_its_start_and_the_second_search_starts_uniform(small, sim, monkeypatch):
+    from emaphm.identification import limits
+
+    trace = sim(K, ideal=False)
+    r = emaphm.identify(reference=trace, seed=1, pop_size=16, uncertainty="none", last_stage="none", start="auto")
+    search = r.settings["stages"][0]
+    assert search["start"] == "table" and search["table_rows"] == 512 and search["table_built"] is True
+    assert search["generations_run"] == limits.TABLE_GENERATIONS
+    assert r.evaluations > 16 * limits.TABLE_GENERATIONS
+    # the second search (made to run here) is the uniform GA with its full budget
+    monkeypatch.setitem(limits.SECOND_SEARCH_NRMSE, "default", 1e-6)
+    r2 = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=None, polish=True, uncertainty="none",
+                         last_stage="none", start="table")  # fmt: skip
+    second = next(st for st in r2.settings["stages"] if st["stage"] == "second_search")
+    assert second["ran"]
+    assert second["stages"][0]["start"] == "random"
+    assert second["stages"][0]["generations_run"] <= limits.DEFAULT_BUDGETS["ga"][1]
+    assert second["stages"][0]["generations_run"] > limits.TABLE_GENERATIONS
+
+
+def test_start_random_is_the_default_uniform_ga_and_start_table_needs_the_ga(small, sim):
+    trace = sim(K, ideal=False)
+    assert IdentifySettings().start == "random"
+    r = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=3, polish=False, last_stage="none",
+                        uncertainty="none")  # fmt: skip
+    assert r.settings["stages"][0]["start"] == "random" and not list(small.glob("*.npz"))
+    with pytest.raises(InputError, match="GA's first population"):
+        IdentifySettings(optimizer="de", start="table")
+    with pytest.raises(InputError, match="unknown start"):
+        IdentifySettings(start="table-ish")
+
+
+def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_path, capsys):
+    import json
+
+    from tests.helpers import EXIT_OF_VERDICT, run_cli
+
+    out = tmp_path / "r.json"
+    code, _, _ = run_cli(["identify", "--true-faults", "0.3,0,0,0.3,0,0,0,0.5", "--seed", "1", "--pop-size", "8",
+                          "--generations", "2", "--no-polish", "--last-stage", "none", "--uncertainty", "none",
+                          "--start", "table", "--output", str(out)], capsys)  # fmt: skip
+    data = json.loads(out.read_text())
+    assert code == EXIT_OF_VERDICT[data["verdict"]]
+    assert data["settings"]["stages"][0]["start"] == "table" and data["settings"]["identify"]["start"] == "table"
+    code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--start", "sideways",
+                            "--output", str(tmp_path / "no.json")], capsys)  # fmt: skip
+    assert code == 2 and "start" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "no.json").exists()
