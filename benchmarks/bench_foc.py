@@ -52,7 +52,7 @@ from _cases import (  # benchmarks/ is the script's folder, first on sys.path
 
 import emaphm
 
-SETTINGS = (*BUDGET, "optimizer", "last_stage")
+SETTINGS = (*BUDGET, "optimizer", "start", "last_stage")
 
 
 def steps_of(text: str) -> tuple[float, ...]:

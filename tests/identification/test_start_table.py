@@ -24,7 +24,7 @@ def small(monkeypatch, tmp_path):
     monkeypatch.setattr(start_table, "TABLE_ROWS", 512)
     monkeypatch.setattr(start_table, "BUILD_BATCH", 128)
     monkeypatch.setenv("EMAPHM_TABLE_DIR", str(tmp_path / "tables"))
-    monkeypatch.setattr(start_table, "_MEMORY", {})
+    monkeypatch.setattr(start_table, "_MEMORY", start_table.OrderedDict())
     return tmp_path / "tables"
 
 
@@ -165,3 +165,18 @@ def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_p
                             "--output", str(tmp_path / "no.json")], capsys)  # fmt: skip
     assert code == 2 and "start" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "no.json").exists()
+
+
+def test_a_process_keeps_only_the_most_recent_tables_in_memory(small, sim, monkeypatch):
+    monkeypatch.setattr(start_table, "MEMORY_TABLES", 2)
+    monkeypatch.setattr(start_table, "TABLE_ROWS", 64)
+    ctx = _context(sim(K, ideal=False))
+    theta = start_table.table_command(ctx)
+    keys = []
+    for scale in (1.0, 0.9, 0.8):  # three commands: three tables
+        table, built = start_table.start_table(ctx, scale * theta)
+        keys.append(table.key)
+        assert built
+    assert list(start_table._MEMORY) == keys[1:]
+    assert start_table.start_table(ctx, 0.9 * theta)[1] is False  # kept, and now the most recent
+    assert list(start_table._MEMORY) == [keys[2], keys[1]]

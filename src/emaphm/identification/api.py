@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -28,7 +27,7 @@ from . import limits
 from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
-from .optimizers import OnGeneration
+from .optimizers import OnGeneration, Progress
 from .preconditions import estimate_doubts
 from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult
@@ -52,7 +51,7 @@ def identify(
     on_generation: OnGeneration | None = None,
     actuator_id: str | None = None,
     baseline: str | os.PathLike[str] | None = None,
-    on_progress: Callable[[str, int, int], None] | None = None,
+    on_progress: Progress | None = None,
     **options: Any,
 ) -> IdentificationResult:
     """Identify the faults from `reference`, or from the HF twin run with `true_faults` (noise on).

@@ -21,7 +21,7 @@ from ..models import MonitorEma
 from ..results import check_time_axis
 from . import limits
 from .fitness import Fitness
-from .optimizers import OnGeneration
+from .optimizers import OnGeneration, Progress
 from .problem import search_to_faults
 from .settings import IdentifySettings
 from .signals import Comparison, nrmse
@@ -59,7 +59,7 @@ class Context:
     # the NRMSE above which a fit is doubtful for this monitor (`verdict.fit_limit`; None: not known)
     doubtful_nrmse: float | None = None
     # progress of work that is not a generation (label, done, total): the start table's build
-    on_progress: Callable[[str, int, int], None] | None = None
+    on_progress: Progress | None = None
 
     def with_seed(self, seed: int) -> Context:
         """The same comparison searched from another optimiser seed (`second_search`)."""
@@ -148,7 +148,7 @@ def prepare(
     monitor: MonitorEma | None = None,
     on_generation: OnGeneration | None = None,
     doubtful_nrmse: float | None = None,
-    on_progress: Callable[[str, int, int], None] | None = None,
+    on_progress: Progress | None = None,
 ) -> Context:
     """Check the measurement i_q [A] at t [s] (under `command`, default the monitor's; `theta_u`
     [rad], the surface position if measured, tells the rests in holds) and set up the comparison."""

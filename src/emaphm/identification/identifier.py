@@ -14,7 +14,6 @@ Uncertainty (6, `uncertainty`) and the verdict (7, `verdict`) follow in `api.ide
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -27,7 +26,7 @@ from ..models import MonitorEma
 from . import search
 from .context import Context, prepare
 from .last_stage import last_stage
-from .optimizers import OnGeneration
+from .optimizers import OnGeneration, Progress
 from .problem import search_to_faults
 from .second_search import second_search
 from .settings import IdentifySettings
@@ -74,7 +73,7 @@ class FaultIdentifier:
         monitor: MonitorEma | str | None = None,
         on_generation: OnGeneration | None = None,
         doubtful_nrmse: float | None = None,
-        on_progress: Callable[[str, int, int], None] | None = None,
+        on_progress: Progress | None = None,
         **options: Any,
     ) -> None:
         if isinstance(monitor, str):  # the monitor by name: the settings' field (docs/conventions.md)

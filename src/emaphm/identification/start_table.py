@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import hashlib
 import os
-from collections.abc import Callable
+from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 
 from ..kernels.fitness import residuals_lf_many
 from .multistart import latin_hypercube
+from .optimizers import Progress
 from .problem import search_to_faults
 
 if TYPE_CHECKING:
@@ -62,8 +63,7 @@ TABLE_ROWS = 16384  # the table's points of the box
 TABLE_STEP = 20  # every TABLE_STEP-th sample of the monitor's grid is stored (the filter passes < 150 Hz)
 TABLE_SEED = 20261201  # the Latin hypercube's seed: a table is a function of its key alone
 BUILD_BATCH = 1024  # monitor runs per kernel call while building (the progress steps)
-
-Progress = Callable[[str, int, int], None]
+MEMORY_TABLES = 4  # tables a process keeps in memory (33 MB each), the most recently used
 
 
 @dataclass(frozen=True)
@@ -176,7 +176,9 @@ def _load(path: Path, key: str) -> StartTable | None:
         return None  # missing, half-copied or foreign: built again
 
 
-_MEMORY: dict[str, StartTable] = {}  # tables of this process (also those that could not be written)
+# tables of this process, most recently used last (also those that could not be written); bounded,
+# so that a long-lived campaign worker diagnosing many actuators does not hold all their tables
+_MEMORY: OrderedDict[str, StartTable] = OrderedDict()
 
 
 def start_table(
@@ -186,6 +188,7 @@ def start_table(
     folder, or built (and kept there); and whether it was built now."""
     key = table_key(context, theta_cmd)
     if key in _MEMORY:
+        _MEMORY.move_to_end(key)
         return _MEMORY[key], False
     path = table_dir() / f"{key[:32]}.npz"
     table = _load(path, key)
@@ -194,6 +197,8 @@ def start_table(
         table = build_table(context, theta_cmd, key, on_progress)
         _save(path, table)
     _MEMORY[key] = table
+    while len(_MEMORY) > MEMORY_TABLES:
+        _MEMORY.popitem(last=False)
     return table, built
 
 
