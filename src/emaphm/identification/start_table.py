@@ -23,7 +23,7 @@ A table depends on everything that sets the monitor's current: the monitor's par
 compared span, the comparison filter, the kernels' sources and the table's own layout; its key
 (`table_key`) is a SHA-256 of all of them. Tables are kept in ``$EMAPHM_TABLE_DIR`` when set,
 else ``$XDG_CACHE_HOME/emaphm/start-tables`` (``~/.cache/...``); one is built the first time its
-key is asked for (16 384 monitor runs: about 5-8 s on 2 cores) and written atomically; where no
+key is asked for (16 384 monitor runs: 8-11 s on a shared 2-core machine) and written atomically; where no
 folder can be written it is built in memory for the process.
 """
 
