@@ -122,12 +122,13 @@ def add_settings(parser: argparse.ArgumentParser, names: tuple[str, ...] = BUDGE
     fields = {f.name: f for f in dataclasses.fields(IdentifySettings)}
     for name in names:
         f = fields[name]
+        f_help = f.metadata["help"].replace("%", "%%")  # argparse formats help strings with %
         flag = "--" + name.replace("_", "-")
         if f.type in (bool, "bool"):
-            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=f.default, help=f.metadata["help"])
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=f.default, help=f_help)
         else:
             kind = {"int | None": int, "int": int, "str": str, "str | None": str}.get(str(f.type), str)
-            parser.add_argument(flag, type=kind, default=f.default, choices=f.metadata["choices"], help=f.metadata["help"])
+            parser.add_argument(flag, type=kind, default=f.default, choices=f.metadata["choices"], help=f_help)
 
 
 def settings_of(args: argparse.Namespace, names: tuple[str, ...] = BUDGET) -> dict[str, Any]:

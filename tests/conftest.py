@@ -36,8 +36,9 @@ def sim():
 
 @pytest.fixture
 def small_polish(monkeypatch):
-    """A CMA-ES polish of 16 x 50 instead of the shipped 32 x 50: half the cost of an
-    identification, same accuracy on the test cases (measured; see the tests that use it)."""
+    """The round CMA-ES polish at 16 x 50 instead of the shipped 32 x 50 (`limits.POLISH_BUDGET`:
+    the final checks' polish, and the best point's under ``POLISH_ROUTE = "round"``): same
+    accuracy on the test cases (measured; see the tests that use it)."""
     from emaphm.identification import limits
 
     budget = (16, 50)

@@ -118,3 +118,13 @@ def test_study_answers_help(path, monkeypatch, capsys):
         runpy.run_path(str(path), run_name="__main__")
     assert exit_.value.code == 0
     assert "usage:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", sorted(SMALLEST), ids=sorted(SMALLEST))
+def test_benchmark_answers_help(name, bench, capsys):
+    """--help prints the usage and exits 0 (the settings' help texts hold a "%", which argparse
+    formats: bench_multifault's --help raised a TypeError until the flags escaped it)."""
+    with pytest.raises(SystemExit) as exit_:
+        bench(name).main(["--help"])
+    assert exit_.value.code == 0
+    assert "usage:" in capsys.readouterr().out

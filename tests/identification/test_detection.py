@@ -21,8 +21,9 @@ def test_shipped_thresholds_file_schema():
 @pytest.mark.slow  # ~5 s: three identifications
 def test_healthy_actuator_raises_no_alarm(small_polish):
     # three noisy healthy twins (other noise and optimiser seeds), the shipped thresholds. Measured
-    # with a GA of 16 x 5 and a 16 x 50 polish over seeds 1..12: the largest departure from healthy
-    # was 0.05-0.65 of its threshold (0.15, 0.18, 0.27 for seeds 1-3), and with every threshold at
+    # with a GA of 16 x 5 and the preconditioned polish over seeds 1..12: the largest departure from
+    # healthy was 0.07-0.49 of its threshold (0.17, 0.13, 0.34 for seeds 1-3; 0.05-0.65 with the
+    # round 16 x 50 polish before issue 36's fourth session), and with every threshold at
     # 1e-4 each of the 12 runs reported 2-6 faults. Without the polish (or with a 16 x 30 one) the
     # estimates stay 0.01-0.3 off and every run raises alarms: the polish is what makes it converge.
     for seed in (1, 2, 3):

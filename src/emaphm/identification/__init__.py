@@ -7,8 +7,9 @@ The pipeline, one module per stage (`identifier.FaultIdentifier.fit` runs 1-5 in
     limits          every tuned constant of the stages               limits.py
     the recording   the twin's, a trace or a rig's recording         recording.py
     prepare         grid, compared samples, weights, eq. 3           context.py (signals, weights, fitness)
-    1 search        the global search over [0, 1]^8                  search.py (optimizers, gwo, cmaes, problem)
-    2 polish        CMA-ES polish of the best point and runner-up    polish.py
+    1 search        the global search over [0, 1]^8                  search.py (optimizers, gwo, cmaes, problem,
+                    (its first population: the start table)            start_table, multistart)
+    2 polish        the best point's and the runner-ups' polishes    polish.py (preconditioned, descents, lm)
     3 final checks  the shorts' phases, a trapped eccentricity       checks.py
       least squares the search's last polish; the fit measured       polish.py, search.py
     4 second search the search again from another seed on a poor fit second_search.py

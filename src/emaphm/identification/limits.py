@@ -54,6 +54,8 @@ __all__ = [
     "POLISH_BUDGET",
     "POLISH_CANDIDATES",
     "POLISH_PATIENCE",
+    "POLISH_ROUTE",
+    "PRECONDITIONED",
     "POSITION_SCALE_TOLERANCE",
     "REST_BAND",
     "REST_SETTLE_S",
@@ -108,6 +110,11 @@ TABLE_GENERATIONS = 15
 # ---- the polish (`polish`) ----
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
 POLISH_PATIENCE = 15  # the CMA-ES polish stops after this many generations without gain
+# the best point's polish (issue 36): "preconditioned" (`preconditioned`: least squares, then a CMA-ES
+# in the Gauss-Newton Hessian's round coordinates, `budget` (population, generations), each axis's step
+# raising the model's f by `scale` f/n, clipped to `steps`) or "round" (a CMA-ES of POLISH_BUDGET)
+POLISH_ROUTE = "preconditioned"
+PRECONDITIONED: dict[str, Any] = {"budget": (16, 30), "scale": 0.5, "steps": (1e-4, 0.1)}
 # a population member counts as another candidate when one of its faults differs from the best's
 # by more than this (k7 on the circle); measured on bench_multifault's 40 x 2 cases (docs/identification.md §3)
 RUNNER_UP_DISTANCE = 0.05
@@ -257,17 +264,11 @@ REVERSAL_FRACTION = 0.01
 
 # ---- the intervals (`uncertainty`) ----
 LAPLACE_STEPS = (1e-3, 3e-3)  # the Laplace step's central-difference steps in k units
-
 NONSMOOTH_RATIO = 1.5  # σ differing by more than this between the two steps: nonsmooth
-
 NON_IDENTIFIABLE = 1e-6  # eigenvalue of JᵀJ below this fraction of the largest
-
 SOKAL_C = 5.0  # Sokal's window: the smallest M with M ≥ c·τ(M)
-
 PINV_RCOND = 1e-12  # directions of JᵀJ below this fraction of the largest are dropped (σ → ∞)
-
 HAC_TAUS = 5.0  # the sandwich's Bartlett window spans this many autocorrelation times
-
 PHASE_SIGMAS = 2.0  # the direction is undefined while ζ̂ < this many σ(ζ)
 
 # the coverage the calibration asks of its own cases: above 0.90, because choosing two factors
@@ -278,13 +279,9 @@ FIT_COVERAGE = 0.92
 
 # ---- the MCMC mode (`uncertainty.mcmc`) ----
 WALKERS = 32
-
 CHUNK = 500
-
 MAX_STEPS = 10_000
-
 MIN_TAUS = 50  # chain length in autocorrelation times before it counts as converged
-
 TAU_RTOL = 0.01
 
 

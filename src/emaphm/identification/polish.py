@@ -1,12 +1,14 @@
 """Stage 2 and the search's last step: the local polishes of the search's best point.
 
-`polish_stage` refines the best point with a small CMA-ES (`polish`) and its distinct runner-ups
-from the final population by least squares on eq. 3's residual vector (`candidates`,
-`polish_runner_ups`: bounded Levenberg–Marquardt descents in lockstep, `descents`), and keeps
-the best; after the final checks (`checks`), `least_squares_stage` ends the search with scipy's
-bounded least squares on the same residuals (`least_squares_polish`), its Jacobian one batch per
-iteration. Both run only with the settings' ``polish``; after the multistart search (whose
-points are least-squares end points) the first does nothing.
+`polish_stage` refines the best point (`limits.POLISH_ROUTE`: "preconditioned", least squares
+then a CMA-ES in the Gauss–Newton Hessian's round coordinates, `preconditioned`; or "round", the
+small CMA-ES of `polish`) and its distinct runner-ups from the final population by least squares
+on eq. 3's residual vector (`candidates`, `polish_runner_ups`: bounded Levenberg–Marquardt
+descents in lockstep, `descents`), and keeps the best; after the final checks (`checks`),
+`least_squares_stage` ends the search with scipy's bounded least squares on the same residuals
+(`least_squares_polish`), its Jacobian one batch per iteration. Both run only with the settings'
+``polish``; after the multistart search (whose points are least-squares end points) the first
+does nothing.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from .optimizers import (
     Stagnation,
     minimize_batch,
 )
+from .preconditioned import preconditioned_polish
 from .problem import recentre_phase
 from .state import Record, State
 
@@ -181,9 +184,10 @@ def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: Optimiz
 
 
 def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
-    """Stage 2: the CMA-ES polish of the search's best point (`polish`), then the least-squares
-    polish of its distinct runner-ups (`polish_runner_ups`); the best kept. Not after the
-    multistart search, whose points are least-squares end points (`multistart`).
+    """Stage 2: the polish of the search's best point (`limits.POLISH_ROUTE`: `preconditioned`'s
+    by default, else the round CMA-ES of `polish`), then the least-squares polish of its distinct
+    runner-ups (`polish_runner_ups`); the best kept. Not after the multistart search, whose points
+    are least-squares end points (`multistart`).
 
     Until issue 36 the best runner-up got a CMA-ES polish of its own (up to 1569 evaluations);
     least squares from up to four of them costs 60–130 LF runs each. Least squares does not
@@ -200,7 +204,12 @@ def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
         # by +0.02 ± 0.02 on 77 paired random runs (BENCHMARKS.md, issue 36)
         return state, {"stage": "polish", "ran": False, "reason": "the multistart search ends in least squares"}
     search = state.run
-    best = polish(context.evaluate, recentre_phase(search), seed=context.seed, on_generation=context.on_generation)
+    start = recentre_phase(search)
+    if limits.POLISH_ROUTE == "preconditioned":
+        best = preconditioned_polish(context.evaluate, context.residuals(), start, seed=context.seed,
+                                     on_generation=context.on_generation)  # fmt: skip
+    else:
+        best = polish(context.evaluate, start, seed=context.seed, on_generation=context.on_generation)
     run, won = polish_runner_ups(context.residuals(), context.evaluate, search, best)
     # runner_up: whether a runner-up's polish gave the point (`candidate`: which, 0 the best point)
     return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": won > 0, "candidate": won, "fitness": run.f}

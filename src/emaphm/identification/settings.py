@@ -48,7 +48,7 @@ class IdentifySettings:
         The GA's first population: uniform ("random", the default and the paper's: 40
         generations), or the best rows of a table of monitor runs kept per actuator, calibration
         and command ("table"; `identification.start_table`; then `limits.TABLE_GENERATIONS`
-        generations by default; opt-in: its %err tail is heavier, BENCHMARKS.md). "auto": the
+        generations by default; opt-in: its intervals hold the truth less often, BENCHMARKS.md). "auto": the
         table for the built-in commands and for recordings of one of the calibration's commands;
         uniform otherwise and for the other optimisers.
     seed : int
@@ -91,8 +91,8 @@ class IdentifySettings:
     start: str = _option(
         "random",
         "The GA's first population: 'random' (default: uniform, 40 generations, the paper's), 'table' (the best "
-        "of 16 384 monitor runs kept per actuator, calibration and command, then 15 generations: 0.76x the time, "
-        "a heavier %err tail) or 'auto' (the table for built-in commands and recordings of a calibrated one; "
+        "of 16 384 monitor runs kept per actuator, calibration and command, then 15 generations: half the monitor "
+        "runs, its intervals hold the truth less often) or 'auto' (the table for built-in commands and recordings of a calibrated one; "
         "docs/identification.md).",
         choices=STARTS,
     )
