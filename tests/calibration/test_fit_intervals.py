@@ -79,3 +79,21 @@ def test_the_last_stage_reaches_every_identification_and_the_record(fake_identif
     assert code == 0 and {c["last_stage"] for c in fake_identify} == {"none"}
     assert json.loads(out.read_text())["last_stage"] == "none"  # as the packaged file has it
     assert load_factors(out, last_stage="none").record["last_stage"] == "none"
+
+
+def test_the_start_reaches_every_identification_and_the_record(fake_identify, tmp_path, capsys):
+    # the table's end points need factors of their own (issue 36): calibrate-uq --start table
+    factors = calibrate_uq(cases=20, seed=11, start="table")
+    assert {c["start"] for c in fake_identify} == {"table"} and factors.record["start"] == "table"
+    fake_identify.clear()
+    assert calibrate_uq(cases=20, seed=11).record["start"] == "random"
+    with pytest.raises(InputError, match="unknown start"):
+        calibrate_uq(cases=20, seed=11, start="sideways")
+    out = tmp_path / "uq.json"
+    fake_identify.clear()
+    code, _, _ = run_cli(["calibrate-uq", "--cases", "20", "--start", "auto", "--output", str(out)], capsys)
+    assert code == 0 and {c["start"] for c in fake_identify} == {"auto"}
+    assert json.loads(out.read_text())["start"] == "auto"
+    code, _, err = run_cli(["calibrate-uq", "--cases", "20", "--start", "sideways", "--output", str(tmp_path / "x.json")], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "sideways" in err
+    assert not (tmp_path / "x.json").exists()

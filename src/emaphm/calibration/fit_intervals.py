@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from .._versions import versions
+from ..choices import STARTS
 from ..actuator import resolve_params
 from ..errors import InputError
 from ..faults import random_faults
@@ -63,6 +64,7 @@ def collect_cases(
     drive_tolerance: float = 0.0,
     tolerance: float = 0.0,
     last_stage: str = "auto",
+    start: str = "random",
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
@@ -74,8 +76,7 @@ def collect_cases(
 
     Parameters
     ----------
-    cases, seed : int
-        The number of cases and the seed of their draws.
+    cases, seed : int — the number of cases and the seed of their draws.
     calibration, monitor : the LF calibration (default: the packaged one) and the monitor model (None: its).
     absent : float
         Probability that each fault of a case is absent (healthy value), in [0, 1].
@@ -85,7 +86,7 @@ def collect_cases(
     params : EmaParams, optional — the actuator (default: the paper's nominal one).
     drive_tolerance, tolerance : float
         The spread of the drawn twins' PI gains (FOC) and of their constants (0: the actuator's own twin).
-    last_stage : the identifications' last stage (`IdentifySettings.last_stage`).
+    last_stage, start : the identifications' last stage and first population (`IdentifySettings`).
     """
     from ..identification.api import identify
     from ..identification.recording import split_seed
@@ -105,7 +106,7 @@ def collect_cases(
             source = {"reference": HighFidelityEma(plant).simulate(k, seed=split_seed(run_seed)[0])}
         r = identify(
             **source, seed=run_seed, calibration=calibration, monitor=monitor,
-            uncertainty="laplace", uq_calibration=Factors.identity(), params=params, last_stage=last_stage,
+            uncertainty="laplace", uq_calibration=Factors.identity(), params=params, last_stage=last_stage, start=start,
         )  # fmt: skip
         if r.uncertainty is None:  # the monitor could not explain the twin: not a usable case
             skipped.append({"case": i, "faults": k.tolist(), "fit_nrmse": r.fit_nrmse})
@@ -143,6 +144,7 @@ def calibrate_uq(
     drive_tolerance: float = DRIVE_TOLERANCE,
     tolerance: float = 0.0,
     last_stage: str = "auto",
+    start: str = "random",
 ) -> Factors:
     """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
 
@@ -176,6 +178,10 @@ def calibrate_uq(
         The identifications' last stage: the factors hold for identifications that end the same way
         (``emaphm identify --last-stage``; the record says which, `identify` warns on a mismatch).
         "none" remakes the packaged ``uq_calibration_no_last_stage.json``.
+    start : {"random", "table", "auto"}
+        The GA's first population (``emaphm identify --start``): the intervals' widths move with
+        the exact end point, and the table's end points need factors of their own (issue 36:
+        the packaged factors held 0.913 of the truth with the table's start, refitted on it 0.929).
     """
     from ..identification.last_stage import resolve_last_stage
 
@@ -187,20 +193,22 @@ def calibrate_uq(
     actuator = resolve_params(params)
     lf = MonitorEma(actuator, calibration=calibration, monitor=monitor).calibration
     stage = resolve_last_stage(last_stage, lf.monitor)  # refused now if unknown
-    start = time.perf_counter()
+    if start not in STARTS:
+        raise InputError(f"unknown start {start!r}; choose one of {', '.join(STARTS)}")
+    began = time.perf_counter()
     data = collect_cases(
         cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator,
-        drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage,
+        drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage, start=start,
     )  # fmt: skip
     fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"], added=data["added_std"])
     record = _record(lf, actuator, data, report, cases=cases, seed=seed, drive_tolerance=drive_tolerance,
-                     tolerance=tolerance, wall=time.perf_counter() - start, last_stage=stage)  # fmt: skip
+                     tolerance=tolerance, wall=time.perf_counter() - began, last_stage=stage, start=start)  # fmt: skip
     return Factors(fitted.scale, fitted.floor, record)
 
 
 def _record(
     lf: Calibration, actuator: EmaParams, data: dict[str, Any], report: dict[str, Any], *, cases: int, seed: int,
-    drive_tolerance: float, tolerance: float, wall: float, last_stage: str,
+    drive_tolerance: float, tolerance: float, wall: float, last_stage: str, start: str = "random",
 ) -> dict[str, Any]:  # fmt: skip
     """The interval calibration's record: how it was made, on what, and its cases' data."""
     from ..identification.weights import resolve_error_corner
@@ -218,6 +226,7 @@ def _record(
         # the last stage the identifications ran (`switching`): it sets how far estimates fall
         # from the truth, so intervals fitted with one do not hold for the other
         "last_stage": last_stage,
+        "start": start,  # the GA's first population (`IdentifySettings.start`; the same reason)
         "cases": cases,
         "seed": seed,
         "absent": UQ_ABSENT,

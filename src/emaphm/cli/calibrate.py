@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from .._threads import numba_threads
+from ..choices import STARTS
 from ..errors import InputError
 from .options import (
     CalibrationOption,
@@ -112,6 +113,13 @@ def calibrate_uq(
             "--last-stage': the intervals hold for identifications that end the same way.",
         ),
     ] = "auto",
+    start: Annotated[
+        str,
+        typer.Option(
+            help="The identifications' first population ('random', 'table', 'auto'), as 'emaphm identify "
+            "--start': the intervals' widths move with the search's end points, so fit them for the start you use.",
+        ),
+    ] = "random",
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from ..actuator import resolve_params
@@ -132,11 +140,14 @@ def calibrate_uq(
     actuator = resolve_params(params)
     lf = MonitorEma(actuator, calibration=calibration, monitor=monitor)  # a calibration that does not fit: now
     resolve_last_stage(last_stage, lf.monitor)  # an unknown one: now
+    if start not in STARTS:
+        raise InputError(f"unknown --start {start!r}; choose one of {', '.join(STARTS)}")
     with numba_threads(workers, name="--workers"), progress() as update:
         report = logged(update)
         factors = run_calibrate_uq(
             cases=cases, seed=seed, calibration=calibration, monitor=monitor, progress=report,
             params=actuator, drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage,
+            start=start,
         )  # fmt: skip
     factors.save(output)
     for case in factors.record["skipped"]:

@@ -31,7 +31,15 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .descents import lm_polish
-from .optimizers import BatchProblem, Objective, OnGeneration, OptimizerRun, Residuals, Stagnation, minimize_batch
+from .optimizers import (
+    BatchProblem,
+    Objective,
+    OnGeneration,
+    OptimizerRun,
+    Residuals,
+    Stagnation,
+    minimize_batch,
+)
 
 __all__ = ["preconditioned_polish", "whitening"]
 
@@ -43,7 +51,9 @@ OUTSIDE_COST = 1e6
 Y_BOUND = 100.0
 
 
-def whitening(J: NDArray[np.float64], f0: float, scale: float, steps: tuple[float, float]) -> NDArray[np.float64]:
+def whitening(
+    J: NDArray[np.float64], f0: float, scale: float, steps: tuple[float, float]
+) -> NDArray[np.float64]:
     """The map M (n × n) with x = x₀ + M y: the eigenvectors of JᵀJ, each scaled so that a unit
     step raises the Gauss–Newton model's f by `scale`·f0/n (the module docstring), the steps
     clipped to `steps` (smallest, largest) in the unit box. A direction the residuals do not see
@@ -59,7 +69,9 @@ def whitening(J: NDArray[np.float64], f0: float, scale: float, steps: tuple[floa
     return V * np.clip(s, steps[0], steps[1])  # type: ignore[no-any-return]
 
 
-def _jacobian(residuals: Residuals, x0: NDArray[np.float64], step: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _jacobian(
+    residuals: Residuals, x0: NDArray[np.float64], step: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The residual at x₀ and its forward-difference Jacobian (backward at the upper bound), in
     one batch of n + 1 monitor runs."""
     n = len(x0)
