@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["LmResult", "levenberg_marquardt", "levenberg_marquardt_many"]
+__all__ = ["LmResult", "forward_probes", "levenberg_marquardt", "levenberg_marquardt_many"]
 
 Batch = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 
@@ -42,6 +42,23 @@ class LmResult:
     nfev: int
     njev: int
     status: str
+
+
+def forward_probes(
+    x: NDArray[np.float64], step: float, upper: float = 1.0
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The n rows of a forward-difference Jacobian at x (row i: x with x_i + h_i) and the steps h:
+    `step`, backward (−`step`) where the forward one would pass `upper`. The polishes' Jacobians
+    (this solver's, `polish.least_squares_polish`'s, `preconditioned`'s) all take these rows;
+    J = ((R − r(x)) / h[:, None])ᵀ from their residuals R.
+
+    x : the point (n,); step : the difference's step; upper : the box's upper bound.
+    """
+    n = len(x)
+    h = np.where(x + step <= upper, step, -step)
+    X = np.repeat(np.asarray(x, dtype=np.float64)[None, :], n, axis=0)
+    X[np.arange(n), np.arange(n)] += h
+    return X, h
 
 
 def _sum_sq(r: NDArray[np.float64]) -> float:
@@ -77,10 +94,7 @@ class _Descent:
         if self.result is not None:
             return None
         if self.A is None:  # a Jacobian at x: forward differences (backward at the upper bound)
-            n = len(self.x)
-            self.h = np.where(self.x + self.step <= self.upper, self.step, -self.step)
-            X = np.repeat(self.x[None, :], n, axis=0)
-            X[np.arange(n), np.arange(n)] += self.h
+            X, self.h = forward_probes(self.x, self.step, self.upper)
             return X
         if self.nfev >= self.max_nfev:
             self._stop("budget")

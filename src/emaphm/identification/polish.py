@@ -20,6 +20,7 @@ from . import limits
 from .cmaes import cmaes
 from .context import Context
 from .descents import candidates, diverged_fill, lm_polish_many
+from .lm import forward_probes
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -145,10 +146,8 @@ def least_squares_polish(
         return finite(at(x))
 
     def jac(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        h = np.where(x + step <= 1.0, step, -step)
         base = finite(at(x))
-        X = np.repeat(x[None, :], n, axis=0)
-        X[np.arange(n), np.arange(n)] += h
+        X, h = forward_probes(x, step)
         R = finite(batch(X))
         return ((R - base) / h[:, None]).T  # type: ignore[no-any-return]
 
@@ -203,14 +202,14 @@ def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
         # its points are least-squares end points already; a CMA-ES from the best moved the %err
         # by +0.02 ± 0.02 on 77 paired random runs (BENCHMARKS.md, issue 36)
         return state, {"stage": "polish", "ran": False, "reason": "the multistart search ends in least squares"}
-    search = state.run
+    search, residuals = state.run, context.residuals()
     start = recentre_phase(search)
     if limits.POLISH_ROUTE == "preconditioned":
-        best = preconditioned_polish(context.evaluate, context.residuals(), start, seed=context.seed,
+        best = preconditioned_polish(context.evaluate, residuals, start, seed=context.seed,
                                      on_generation=context.on_generation)  # fmt: skip
     else:
         best = polish(context.evaluate, start, seed=context.seed, on_generation=context.on_generation)
-    run, won = polish_runner_ups(context.residuals(), context.evaluate, search, best)
+    run, won = polish_runner_ups(residuals, context.evaluate, search, best)
     # runner_up: whether a runner-up's polish gave the point (`candidate`: which, 0 the best point)
     return state.with_run(run), {"stage": "polish", "ran": True, "runner_up": won > 0, "candidate": won, "fitness": run.f}
 

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from . import limits
 from .cmaes import cmaes
 from .descents import lm_polish
+from .lm import forward_probes
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -72,13 +73,10 @@ def whitening(
 def _jacobian(
     residuals: Residuals, x0: NDArray[np.float64], step: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The residual at x₀ and its forward-difference Jacobian (backward at the upper bound), in
-    one batch of n + 1 monitor runs."""
-    n = len(x0)
-    h = np.where(x0 + step <= 1.0, step, -step)
-    X = np.repeat(x0[None, :], n + 1, axis=0)
-    X[np.arange(1, n + 1), np.arange(n)] += h
-    R = np.asarray(residuals(X), dtype=np.float64)
+    """The residual at x₀ and its forward-difference Jacobian (`lm.forward_probes`: backward at
+    the upper bound), in one batch of n + 1 monitor runs."""
+    probes, h = forward_probes(x0, step)
+    R = np.asarray(residuals(np.vstack([x0[None, :], probes])), dtype=np.float64)
     return R[0], ((R[1:] - R[0]) / h[:, None]).T
 
 
