@@ -115,8 +115,9 @@ def main(argv: list[str] | None = None) -> None:
                     0.0 if m["prognostic_horizon"] is None else m["prognostic_horizon"] / (t_star - onset)
                 )
                 pp_cra.append(m["cra"])
+            band = "-".join("     -" if v is None else f"{v:6.1f}" for v in (p["rul_p05"], p["rul_p95"]))
             print(f"{act['id']:>8} {fault:>9} {t_star:6.1f} {onset:>5} {at:>4} {true:6.1f} {p['rul_median']:6.1f} "
-                  f"{p['rul_p05']:6.1f}-{p['rul_p95']:6.1f} {'yes' if ok else 'no':>4} {ph:7.2f}")  # fmt: skip
+                  f"{band} {'yes' if ok else 'no':>4} {ph:7.2f}")  # fmt: skip
     print()
     print(f"alpha-lambda (alpha {args.alpha:g}, lambda {100 * args.lam:g} % of life) met: {met} of {n} "
           f"({100 * met / max(n, 1):.0f} %); true RUL inside the 5-95 % range: {covered} of {n} "

@@ -19,8 +19,8 @@ __all__ = [
 
 # the global search (`identification.search`): the paper's GA, DE, PSO, CMA-ES, grey wolf
 OPTIMIZERS = ("ga", "de", "pso", "cmaes", "gwo", "multistart")
-# the GA's first population (`identification.start_table`): "random" uniform (the default, the
-# paper's), "table" from the start table, "auto" the table for built-in commands and recordings of one
+# the GA's first population (`identification.start_table`): "random" uniform (the paper's),
+# "table" from the start table, "auto" (the default) the table for built-in commands and recordings of one
 STARTS = ("random", "table", "auto")
 # the 90 % intervals of each fault (`identification.uncertainty`)
 UQ_METHODS = ("none", "laplace", "mcmc")

@@ -86,7 +86,7 @@ def test_the_start_reaches_every_identification_and_the_record(fake_identify, tm
     factors = calibrate_uq(cases=20, seed=11, start="table")
     assert {c["start"] for c in fake_identify} == {"table"} and factors.record["start"] == "table"
     fake_identify.clear()
-    assert calibrate_uq(cases=20, seed=11).record["start"] == "random"
+    assert calibrate_uq(cases=20, seed=11).record["start"] == "auto"  # as identify's default
     with pytest.raises(InputError, match="unknown start"):
         calibrate_uq(cases=20, seed=11, start="sideways")
     out = tmp_path / "uq.json"

@@ -137,11 +137,11 @@ def test_an_identification_records_its_start_and_the_second_search_starts_unifor
     assert second["stages"][0]["generations_run"] > limits.TABLE_GENERATIONS
 
 
-def test_start_random_is_the_default_uniform_ga_and_start_table_needs_the_ga(small, sim):
+def test_start_auto_is_the_default_random_a_uniform_ga_and_start_table_needs_the_ga(small, sim):
     trace = sim(K, ideal=False)
-    assert IdentifySettings().start == "random"
+    assert IdentifySettings().start == "auto"
     r = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=3, polish=False, last_stage="none",
-                        uncertainty="none")  # fmt: skip
+                        uncertainty="none", start="random")  # fmt: skip
     assert r.settings["stages"][0]["start"] == "random" and not list(small.glob("*.npz"))
     with pytest.raises(InputError, match="GA's first population"):
         IdentifySettings(optimizer="de", start="table")

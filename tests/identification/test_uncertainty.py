@@ -11,6 +11,7 @@ import pytest
 
 from emaphm import InputError
 from emaphm.identification.fitness import Fitness
+from emaphm.identification.settings import IdentifySettings
 from emaphm.identification.signals import Comparison
 from emaphm.identification.uncertainty import (
     Factors,
@@ -24,6 +25,7 @@ from emaphm.identification.uncertainty import (
     to_faults,
     verdicts,
 )
+from emaphm.models import MonitorEma
 
 F_S = 10_000.0
 
@@ -219,9 +221,11 @@ def test_the_packaged_calibration_belongs_to_the_packaged_monitor():
         assert packaged.record["last_stage"] == stage  # each made for its own last stage
     default, switching = load_factors(), load_factors(last_stage="switching")  # the default identification's
     assert default.record == switching.record and default.scale is switching.scale  # one file, read once
-    # the switching stage's file is fitted to the intervals widened for the constants (issue 33, its
-    # record's "fit" and added_std); the older one without the stage is not (it predates the widening)
-    assert "added_std" in switching.record["data"] and "added_std" not in load_factors(last_stage="none").record["data"]
+    # both files are fitted to the intervals widened for the constants (issue 33: the record's "fit"
+    # and added_std; the one without the stage since issue 36's refit for the default start)
+    for stage in ("switching", "none"):
+        record = load_factors(last_stage=stage).record
+        assert "added_std" in record["data"] and record["fit"]["cases"] == record["cases"]
     with pytest.raises(InputError, match="last stage"):
         load_factors(last_stage="auto")
 
@@ -240,6 +244,23 @@ def test_identify_takes_the_interval_calibration_of_its_last_stage_and_warns_on_
     # a calibration made with the stage, given to an identification without it: said so
     res = identify(k, last_stage="none", uq_calibration=load_factors(last_stage="switching"), **small)
     assert any("fitted on identifications with the last stage 'switching'" in w for w in res.warnings)
+    # a calibration fitted from uniform starts (before issue 36 files record none) under a table's
+    # start: its intervals may be too narrow, said so; from the table (the default) or wider, nothing
+    uniform = load_factors()
+    uniform.record.pop("start")
+    res = identify(k, uq_calibration=uniform, **small)
+    assert res.settings["stages"][0]["start"] == "table"
+    assert sum("from a uniform start" in w for w in res.warnings) == 1
+    res = identify(k, uq_calibration=uniform, start="random", **small)
+    assert not any("uniform start" in w for w in res.warnings)
+
+
+def test_the_packaged_interval_calibrations_were_fitted_for_the_default_start():
+    for stage in ("switching", "none"):
+        record = load_factors(last_stage=stage).record
+        assert record["start"] == IdentifySettings().start and record["last_stage"] == stage
+        doubt, other = load_factors(last_stage=stage).mismatch(MonitorEma().calibration, stage, "table")
+        assert doubt is None and not other
 
 
 def test_mcmc_on_the_linear_oracle_is_reproducible_and_brackets_the_truth():
@@ -275,10 +296,10 @@ def test_identify_with_another_monitor_falls_back_to_noise_only_intervals_and_sa
         assert res.uncertainty is None
         return
     assert any("interval calibration" in w for w in res.warnings)
-    assert res.settings["uq_calibration"]["calibrated"] is False
-    np.testing.assert_allclose(
-        res.uncertainty.std[[0, 1, 2, 3, 4, 7]], res.uncertainty.raw_std[[0, 1, 2, 3, 4, 7]]
-    )
+    assert res.settings["uq_calibration"]["calibrated"] is False and not res.uncertainty.details["calibrated"]
+    # no factors: the noise's width, widened only for the actuator's tolerances (`uncertainty.constants`)
+    u, j = res.uncertainty, [0, 1, 2, 3, 4, 7]
+    np.testing.assert_allclose(u.std[j], np.hypot(u.raw_std[j], np.asarray(u.details["constants_std"])[j]), rtol=1e-4)
 
 
 def test_identify_with_mcmc_runs_the_chain_and_warns_when_it_stops_at_the_cap(monkeypatch):

@@ -64,7 +64,7 @@ def collect_cases(
     drive_tolerance: float = 0.0,
     tolerance: float = 0.0,
     last_stage: str = "auto",
-    start: str = "random",
+    start: str = "auto",
 ) -> dict[str, Any]:
     """Identify random actuators `first`..`cases`−1 of `seed` (HF twin, noise on; case i with the
     identification seed 1000·seed + i) with noise-only Laplace intervals: {"truths", "estimates",
@@ -144,7 +144,7 @@ def calibrate_uq(
     drive_tolerance: float = DRIVE_TOLERANCE,
     tolerance: float = 0.0,
     last_stage: str = "auto",
-    start: str = "random",
+    start: str = "auto",
 ) -> Factors:
     """Fit the interval calibration on `cases` random HF actuators (about 5 s each on 2 cores).
 
@@ -208,7 +208,7 @@ def calibrate_uq(
 
 def _record(
     lf: Calibration, actuator: EmaParams, data: dict[str, Any], report: dict[str, Any], *, cases: int, seed: int,
-    drive_tolerance: float, tolerance: float, wall: float, last_stage: str, start: str = "random",
+    drive_tolerance: float, tolerance: float, wall: float, last_stage: str, start: str = "auto",
 ) -> dict[str, Any]:  # fmt: skip
     """The interval calibration's record: how it was made, on what, and its cases' data."""
     from ..identification.weights import resolve_error_corner

@@ -119,7 +119,7 @@ def calibrate_uq(
             help="The identifications' first population ('random', 'table', 'auto'), as 'emaphm identify "
             "--start': the intervals' widths move with the search's end points, so fit them for the start you use.",
         ),
-    ] = "random",
+    ] = "auto",
 ) -> None:
     """Re-fit the calibration of the 90 % intervals for the monitor's bias (after 'emaphm calibrate')."""
     from ..actuator import resolve_params

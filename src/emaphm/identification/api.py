@@ -198,19 +198,11 @@ def _intervals(
     from .uncertainty import laplace
     from .uncertainty.constants import constants_covariance
 
-    calibration = ident.monitor_.calibration
-    made_with = factors.record.get("last_stage", "none") if factors.record else None
-    if factors.record and not factors.matches(calibration):
-        warnings.append(
-            "the interval calibration was fitted with another LF calibration or monitor: the "
-            "intervals show the measurement noise only, not the model's bias (run 'emaphm calibrate-uq')"
-        )
-        factors = Factors.identity()
-    elif made_with is not None and made_with != ident.last_stage_:
-        warnings.append(
-            f"the interval calibration was fitted on identifications with the last stage {made_with!r}, this one "
-            f"ran {ident.last_stage_!r}: its intervals may not hold (run 'emaphm calibrate-uq' with the same settings)"
-        )
+    search = ident.record("search") or {}
+    doubt, other = factors.mismatch(ident.monitor_.calibration, ident.last_stage_, str(search.get("start", "random")))
+    if doubt is not None:
+        warnings.append(doubt)
+    factors = Factors.identity() if other else factors
     start = time.perf_counter()
     interval = None
     with numba_threads(s.workers):

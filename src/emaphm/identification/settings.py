@@ -45,12 +45,13 @@ class IdentifySettings:
         (`identification.multistart`): a Latin-hypercube sample and least-squares descents from
         its best points, a third of the monitor runs but less robust (screening).
     start : {"random", "table", "auto"}
-        The GA's first population: uniform ("random", the default and the paper's: 40
-        generations), or the best rows of a table of monitor runs kept per actuator, calibration
-        and command ("table"; `identification.start_table`; then `limits.TABLE_GENERATIONS`
-        generations by default; opt-in: its intervals hold the truth less often, BENCHMARKS.md). "auto": the
-        table for the built-in commands and for recordings of one of the calibration's commands;
-        uniform otherwise and for the other optimisers.
+        The GA's first population: uniform ("random", the paper's: 40 generations), or the best
+        rows of a table of monitor runs kept per actuator, calibration and command ("table";
+        `identification.start_table`; then `limits.TABLE_GENERATIONS` generations by default;
+        about half the monitor runs, BENCHMARKS.md). "auto" (the default): the table for the
+        built-in commands and for recordings of one of the calibration's commands; uniform
+        otherwise and for the other optimisers. The interval calibration should be fitted with
+        the same start (``emaphm calibrate-uq --start``; `identify` warns where it was not).
     seed : int
         The user's seed, 0..2^63 − 1: `emaphm.identify` splits it into the twin's noise seed and
         the optimiser's; `FaultIdentifier` uses it as the optimiser's.
@@ -89,11 +90,11 @@ class IdentifySettings:
         choices=OPTIMIZERS,
     )
     start: str = _option(
-        "random",
-        "The GA's first population: 'random' (default: uniform, 40 generations, the paper's), 'table' (the best "
-        "of 16 384 monitor runs kept per actuator, calibration and command, then 15 generations: half the monitor "
-        "runs, its intervals hold the truth less often) or 'auto' (the table for built-in commands and recordings of a calibrated one; "
-        "docs/identification.md).",
+        "auto",
+        "The GA's first population: 'auto' (default: 'table' for built-in commands and recordings of a "
+        "calibrated one, else 'random'), 'table' (the best of 16 384 monitor runs, built once per actuator, "
+        "calibration and command and kept, then 15 generations: about half the monitor runs) or 'random' "
+        "(uniform, 40 generations, the paper's; docs/identification.md).",
         choices=STARTS,
     )
     seed: int = _option(0, "Seed of the optimiser (and of the twin's noise).")

@@ -110,6 +110,33 @@ class Factors:
             and key.get("params_hash") == calibration.params_hash
         )
 
+    def mismatch(self, calibration: Calibration, last_stage: str, start: str) -> tuple[str | None, bool]:
+        """What keeps these factors from holding for an identification with this LF `calibration`
+        that ran `last_stage` ("switching", "none") from `start` (its search record's: "random",
+        "table"): a warning or None, and whether they belong to another calibration (then the
+        intervals show the measurement noise only). Files before issue 36 record no start: uniform."""
+        if not self.record:
+            return None, False
+        if not self.matches(calibration):
+            return (
+                "the interval calibration was fitted with another LF calibration or monitor: the "
+                "intervals show the measurement noise only, not the model's bias (run 'emaphm calibrate-uq')"
+            ), True
+        made_with = self.record.get("last_stage", "none")
+        if made_with != last_stage:
+            return (
+                f"the interval calibration was fitted on identifications with the last stage {made_with!r}, this "
+                f"one ran {last_stage!r}: its intervals may not hold (run 'emaphm calibrate-uq' with the same settings)"
+            ), False
+        # the table's end points need wider factors than the uniform start's (BENCHMARKS.md, issue 36);
+        # the other way round the intervals are only wider than they need be
+        if start == "table" and self.record.get("start", "random") == "random":
+            return (
+                "the interval calibration was fitted on identifications from a uniform start, this one started "
+                "from the start table: its intervals may be too narrow (run 'emaphm calibrate-uq --start auto')"
+            ), False
+        return None, False
+
 
 # the packaged interval calibrations, by the identification's last stage (`choices.LAST_STAGES`):
 # the switching stage leaves estimates about half as far from the truth, so its intervals are
