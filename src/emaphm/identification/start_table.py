@@ -10,7 +10,9 @@ are the GA's first population. The GA then runs `limits.TABLE_GENERATIONS` gener
 its 40 from a uniform population, and the polishes, checks, second search and last stage follow
 as before. The table is only a start: every point it gives is evaluated by the monitor before the
 search keeps it, and a poor fit still starts the second search, which searches from a uniform
-population with the full budget (`second_search`).
+population with the full budget (`second_search`). It is the default first population
+(``start`` "auto", `uses_table`) since issue 36's fifth session; the packaged interval
+calibrations are fitted for it.
 
 Why: the GA's 40 generations carry the basin (BENCHMARKS.md, issue 36: shorter GAs, samples of a
 few thousand points and least-squares multistarts each fell into wrong basins on some case). A
