@@ -86,6 +86,32 @@ def test_a_table_is_kept_by_its_key_and_read_back_the_same(small, sim):
     assert start_table.start_table(ctx, theta)[1]
 
 
+def test_the_table_folder_keeps_the_most_recently_used_tables_within_its_bound(small, sim, monkeypatch, tmp_path):
+    import os
+
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    paths = [folder / f"{c * 32}.npz" for c in "abcd"]
+    for age, path in enumerate(paths):
+        path.write_bytes(b"x" * 2**20)  # 1 MiB each, a the oldest
+        os.utime(path, (1000.0 + age, 1000.0 + age))
+    os.utime(paths[0], (2000.0, 2000.0))  # a read since: now the newest
+    monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", "3.5")
+    assert start_table.prune(folder, keep=paths[1]) == [paths[2]]  # b kept as asked, c the oldest after it
+    assert sorted(p.name[0] for p in folder.glob("*.npz")) == ["a", "b", "d"]
+    monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", "0")  # no bound
+    assert start_table.prune(folder) == []
+    # through `start_table`: a table written beyond the bound removes the older ones, not itself
+    monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", "1")
+    small.mkdir(parents=True)
+    old = small / ("e" * 32 + ".npz")
+    old.write_bytes(b"x" * 2**20)
+    os.utime(old, (1000.0, 1000.0))
+    ctx = _context(sim(K, ideal=False))
+    assert start_table.start_table(ctx, start_table.table_command(ctx))[1]
+    assert not old.exists() and len(list(small.glob("*.npz"))) == 1
+
+
 def test_a_folder_that_cannot_be_written_builds_the_table_in_memory(small, sim, monkeypatch, tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")

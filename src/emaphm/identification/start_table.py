@@ -26,7 +26,9 @@ compared span, the comparison filter, the kernels' sources and the table's own l
 (`table_key`) is a SHA-256 of all of them. Tables are kept in ``$EMAPHM_TABLE_DIR`` when set,
 else ``$XDG_CACHE_HOME/emaphm/start-tables`` (``~/.cache/...``); one is built the first time its
 key is asked for (16 384 monitor runs: 8-11 s on a shared 2-core machine) and written atomically; where no
-folder can be written it is built in memory for the process.
+folder can be written it is built in memory for the process. The folder is bounded (`prune`: the
+least recently used tables go beyond ``$EMAPHM_TABLE_CACHE_MB``, 2 GiB by default), since every
+actuator with its own baseline has a table of its own.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ __all__ = [
     "StartTable",
     "build_table",
     "first_population",
+    "prune",
     "start_table",
     "table_command",
     "table_dir",
@@ -68,7 +71,11 @@ BUILD_BATCH = 1024  # monitor runs per kernel call while building (the progress 
 # rows ranked at once: a 2 MB temporary; the whole table at once made 130 MB of fresh pages, 0.1 s
 # of page faults in a new process (the same numbers)
 RANK_CHUNK = 512
-MEMORY_TABLES = 4  # tables a process keeps in memory (33 MB each), the most recently used
+MEMORY_TABLES = 4
+# the table folder is kept under this many MiB (``$EMAPHM_TABLE_CACHE_MB``; 0: no bound): after a
+# table is written, the least recently used ones go (`prune`); a table gone is built again, the same.
+# 2 GiB holds about 120 tables of the 1 s chirp, a fleet of baselined actuators needs one each
+TABLE_CACHE_MB = 2048  # tables a process keeps in memory (33 MB each), the most recently used
 
 
 @dataclass(frozen=True)
@@ -180,9 +187,41 @@ def _load(path: Path, key: str) -> StartTable | None:
         with np.load(path, allow_pickle=False) as data:
             if str(data["key"]) != key:
                 return None
-            return StartTable(data["X"], data["T"].astype(np.float32), data["index"].astype(np.intp), key)
+            table = StartTable(data["X"], data["T"].astype(np.float32), data["index"].astype(np.intp), key)
+        os.utime(path)  # its use, for `prune`
+        return table
     except (OSError, ValueError, KeyError):
         return None  # missing, half-copied or foreign: built again
+
+
+def prune(folder: Path, keep: Path | None = None) -> list[Path]:
+    """Remove the least recently used tables (by modification time: written or read) until the
+    folder's tables take at most ``$EMAPHM_TABLE_CACHE_MB`` (default `TABLE_CACHE_MB`; 0: no
+    bound), never `keep`; returns those removed."""
+    try:
+        limit = float(os.environ.get("EMAPHM_TABLE_CACHE_MB", TABLE_CACHE_MB)) * 2**20
+    except ValueError:
+        limit = TABLE_CACHE_MB * 2**20  # an unreadable setting: the default
+    kept: list[tuple[float, int, Path]] = []
+    for path in folder.glob("*.npz"):
+        try:
+            st = path.stat()
+        except OSError:
+            continue  # removed by another process meanwhile
+        kept.append((st.st_mtime, st.st_size, path))
+    total, removed = sum(size for _, size, _ in kept), []
+    for _, size, path in sorted(kept):  # the oldest first
+        if limit <= 0 or total <= limit:
+            break
+        if path == keep:
+            continue
+        try:
+            path.unlink()
+        except OSError:
+            continue
+        total -= size
+        removed.append(path)
+    return removed
 
 
 # tables of this process, most recently used last (also those that could not be written); bounded,
@@ -218,6 +257,7 @@ def _save(path: Path, table: StartTable) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, X=table.X, T=table.T.astype(np.float16), index=table.index, key=np.array(table.key))
+        prune(path.parent, keep=path)
     except OSError:
         pass  # a folder that cannot be written: the table lives in this process only
 
