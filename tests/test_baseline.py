@@ -84,6 +84,9 @@ def test_identify_with_the_baseline_reads_the_short_right_where_the_nameplate_do
     assert based.settings["baseline"]["directory"] == str(folder) and based.settings["baseline"]["current_gain"] > 1.04
     assert alone.settings["baseline"] is None
     assert based.uncertainty.details["constants_from"].startswith("the baseline's fit")
+    # one actuator's own monitor: "auto" starts uniform (a table would serve few diagnoses), recorded so
+    assert alone.settings["stages"][0]["start"] == "table"
+    assert based.settings["stages"][0]["start"] == "random" and based.settings["identify"]["start"] == "random"
 
 
 def test_recordings_of_two_actuators_are_refused_with_the_reason(healthy, tmp_path):

@@ -70,11 +70,11 @@ def identify(
     on_progress : progress callback (label, done, total) of the start table's build (`start_table`).
     actuator_id : the actuator's id (serial, tail position), recorded as ``settings["actuator_id"]``.
     baseline : a folder from `emaphm.baseline` (``emaphm baseline``): the actuator's own file,
-        calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``.
+        calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``;
+        with it the start "auto" is a uniform one (``start`` "table" still builds its table).
     """
-    s = IdentifySettings.resolve(settings, options)
-    params, calibration, uq_calibration, thresholds, used = _with_baseline(
-        baseline, params, calibration, uq_calibration, thresholds
+    s, params, calibration, uq_calibration, thresholds, used = _with_baseline(
+        baseline, IdentifySettings.resolve(settings, options), params, calibration, uq_calibration, thresholds
     )
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
     start = time.perf_counter()
@@ -121,16 +121,19 @@ def identify(
 
 
 def _with_baseline(
-    baseline: Any, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
+    baseline: Any, s: IdentifySettings, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
 ) -> tuple[Any, ...]:
-    """The inputs a baseline folder gives (`baseline.baseline_inputs`) and its record; as given without one."""
+    """The settings and the inputs a baseline folder gives (`baseline.baseline_inputs`) and its
+    record; as given without one. With one, the start "auto" is uniform: one actuator's own
+    monitor, whose table would serve few diagnoses for its 9 s build (docs/identification.md §3)."""
     if baseline is None:
-        return params, calibration, uq_calibration, thresholds, None
+        return s, params, calibration, uq_calibration, thresholds, None
     from ..baseline import baseline_inputs
 
     b = baseline_inputs(baseline, params=params, calibration=calibration, uq_calibration=uq_calibration,
                         thresholds=thresholds)  # fmt: skip
     return (
+        s.replace(start="random") if s.start == "auto" else s,  # recorded so
         b["params"],
         b["calibration"],
         b["uq_calibration"],

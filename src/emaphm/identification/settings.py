@@ -50,8 +50,9 @@ class IdentifySettings:
         `identification.start_table`; then `limits.TABLE_GENERATIONS` generations by default;
         about half the monitor runs, BENCHMARKS.md). "auto" (the default): the table for the
         built-in commands and for recordings of one of the calibration's commands; uniform
-        otherwise and for the other optimisers. The interval calibration should be fitted with
-        the same start (``emaphm calibrate-uq --start``; `identify` warns where it was not).
+        otherwise, for the other optimisers and with an actuator's own baseline
+        (`emaphm.identify`). The interval calibration should be fitted with the same start
+        (``emaphm calibrate-uq --start``; `identify` warns where it was not).
     seed : int
         The user's seed, 0..2^63 − 1: `emaphm.identify` splits it into the twin's noise seed and
         the optimiser's; `FaultIdentifier` uses it as the optimiser's.
