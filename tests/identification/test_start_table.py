@@ -175,7 +175,7 @@ def test_start_auto_is_the_default_random_a_uniform_ga_and_start_table_needs_the
         IdentifySettings(start="table-ish")
 
 
-def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_path, capsys):
+def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_path, capsys, monkeypatch):
     import json
 
     from tests.helpers import EXIT_OF_VERDICT, run_cli
@@ -191,6 +191,14 @@ def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_p
                             "--output", str(tmp_path / "no.json")], capsys)  # fmt: skip
     assert code == 2 and "start" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "no.json").exists()
+    # a table folder's bound that is not a number of MiB: refused in one line, no new table, no output
+    tables = sorted(small.glob("*.npz"))
+    for bad in ("lots", "-1"):
+        monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", bad)
+        code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--pop-size", "8",
+                                "--generations", "2", "--output", str(tmp_path / "no.json")], capsys)  # fmt: skip
+        assert code == 2 and "EMAPHM_TABLE_CACHE_MB" in err and len(err.strip().splitlines()) == 1
+        assert not (tmp_path / "no.json").exists() and sorted(small.glob("*.npz")) == tables
 
 
 def test_a_process_keeps_only_the_most_recent_tables_in_memory(small, sim, monkeypatch):

@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import InputError
 from ..kernels.fitness import residuals_lf_many
 from .multistart import latin_hypercube
 from .optimizers import Progress
@@ -54,6 +55,7 @@ if TYPE_CHECKING:
 __all__ = [
     "StartTable",
     "build_table",
+    "cache_limit",
     "first_population",
     "prune",
     "start_table",
@@ -68,14 +70,14 @@ TABLE_ROWS = 16384  # the table's points of the box
 TABLE_STEP = 20  # every TABLE_STEP-th sample of the monitor's grid is stored (the filter passes < 150 Hz)
 TABLE_SEED = 20261201  # the Latin hypercube's seed: a table is a function of its key alone
 BUILD_BATCH = 1024  # monitor runs per kernel call while building (the progress steps)
-# rows ranked at once: a 2 MB temporary; the whole table at once made 130 MB of fresh pages, 0.1 s
-# of page faults in a new process (the same numbers)
+# rows ranked at once: a 2 MB temporary. The whole table at once made two 66 MB ones, fresh pages in
+# a new process: 0.15 s in a profile of one identification, against 8-15 ms chunked (the same numbers)
 RANK_CHUNK = 512
-MEMORY_TABLES = 4
+MEMORY_TABLES = 4  # tables a process keeps in memory (33 MB each), the most recently used
 # the table folder is kept under this many MiB (``$EMAPHM_TABLE_CACHE_MB``; 0: no bound): after a
 # table is written, the least recently used ones go (`prune`); a table gone is built again, the same.
 # 2 GiB holds about 120 tables of the 1 s chirp, a fleet of baselined actuators needs one each
-TABLE_CACHE_MB = 2048  # tables a process keeps in memory (33 MB each), the most recently used
+TABLE_CACHE_MB = 2048
 
 
 @dataclass(frozen=True)
@@ -194,14 +196,24 @@ def _load(path: Path, key: str) -> StartTable | None:
         return None  # missing, half-copied or foreign: built again
 
 
+def cache_limit() -> float:
+    """The table folder's bound in bytes: ``$EMAPHM_TABLE_CACHE_MB`` MiB (default `TABLE_CACHE_MB`;
+    0: none); a setting that is not a number of MiB >= 0 is refused in one line."""
+    given = os.environ.get("EMAPHM_TABLE_CACHE_MB", str(TABLE_CACHE_MB))
+    try:
+        mib = float(given)
+    except ValueError:
+        mib = float("nan")
+    if not mib >= 0 or mib == float("inf"):
+        raise InputError(f"EMAPHM_TABLE_CACHE_MB must be a number of MiB (0: no bound), got {given!r}")
+    return mib * 2**20
+
+
 def prune(folder: Path, keep: Path | None = None) -> list[Path]:
     """Remove the least recently used tables (by modification time: written or read) until the
-    folder's tables take at most ``$EMAPHM_TABLE_CACHE_MB`` (default `TABLE_CACHE_MB`; 0: no
-    bound), never `keep`; returns those removed."""
-    try:
-        limit = float(os.environ.get("EMAPHM_TABLE_CACHE_MB", TABLE_CACHE_MB)) * 2**20
-    except ValueError:
-        limit = TABLE_CACHE_MB * 2**20  # an unreadable setting: the default
+    folder's tables take at most `cache_limit` bytes (0: no bound), never `keep`; returns those
+    removed."""
+    limit = cache_limit()
     kept: list[tuple[float, int, Path]] = []
     for path in folder.glob("*.npz"):
         try:
@@ -234,6 +246,7 @@ def start_table(
 ) -> tuple[StartTable, bool]:
     """The context's table under `theta_cmd` (`table_command`), from this process, the table
     folder, or built (and kept there); and whether it was built now."""
+    cache_limit()  # a bad bound is refused before any work, wherever the table comes from
     key = table_key(context, theta_cmd)
     if key in _MEMORY:
         _MEMORY.move_to_end(key)
