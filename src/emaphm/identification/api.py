@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -24,6 +23,7 @@ from ..models import MonitorEma
 from ..params import EmaParams
 from ..results import SimResult
 from . import limits
+from .baseline_inputs import divided_by_gain, with_baseline
 from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
@@ -33,6 +33,8 @@ from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult
 from .settings import IdentifySettings
 from .uncertainty import Factors, Uncertainty, load_factors
+from .uncertainty.balanced import allowance, lower
+from .uncertainty.balanced import doubts as balanced_doubts
 from .verdict import explains, fit_doubts, fit_limit, fit_warnings, judge, recording_warnings
 
 __all__ = ["identify"]
@@ -73,17 +75,15 @@ def identify(
         calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``;
         with it the start "auto" is a uniform one (``start`` "table" still builds its table).
     """
-    s, params, calibration, uq_calibration, thresholds, used = _with_baseline(
+    s, params, calibration, uq_calibration, thresholds, used = with_baseline(
         baseline, IdentifySettings.resolve(settings, options), params, calibration, uq_calibration, thresholds
     )
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
     start = time.perf_counter()
     noise_seed, opt_seed = split_seed(s.seed)
-    m = measurement(true_faults, reference, channel_map, actuator, noise_seed)
-    if used is not None and used["current_gain"] != 1.0:  # the sensor's gain the baseline measured
-        signals = {**m.trace.signals, "i_q": m.trace.i_q / used["current_gain"]}
-        m = replace(m, trace=SimResult(t=m.trace.t, signals=signals, metadata=m.trace.metadata))
+    m = divided_by_gain(measurement(true_faults, reference, channel_map, actuator, noise_seed), used)
     doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
+    balanced = allowance(params, used is not None)  # ψ_m's share of the shorts (`uncertainty.balanced`)
     ident = FaultIdentifier(s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation,
                             doubtful_nrmse=doubtful[0], on_progress=on_progress)  # fmt: skip
     with numba_threads(s.workers):
@@ -95,15 +95,15 @@ def identify(
     ]  # fmt: skip
     interval = None
     if factors is not None and explains(ident.fit_nrmse_):
-        interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings, params)
+        interval = _intervals(ident, factors, s, opt_seed, on_generation, warnings, params, balanced)
     warnings += fit_warnings(ident.fit_nrmse_)
     warnings += fit_doubts(ident.fit_nrmse_, *doubtful, ident.record("second_search"))
-    detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds)
+    detected, judged = judge(ident.faults_, ident.fit_nrmse_, interval, thresholds, balanced[0])
     checked: dict[str, Any] = {"motion": None, "current_scale": None}
     if explains(ident.fit_nrmse_):
         with numba_threads(s.workers):
             doubted, checked = estimate_doubts(ident.context_, ident.faults_, detected, m.trace.t, m.theta_u, params)
-        warnings += doubted
+        warnings += doubted + balanced_doubts(ident.faults_, *balanced, thresholds)
     doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
     doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
@@ -118,28 +118,6 @@ def identify(
         fit_nrmse=ident.fit_nrmse_, uncertainty=interval, fault_verdicts=judged, curves=ident.curves(),
         doubts=doubts,
     )  # fmt: skip
-
-
-def _with_baseline(
-    baseline: Any, s: IdentifySettings, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
-) -> tuple[Any, ...]:
-    """The settings and the inputs a baseline folder gives (`baseline.baseline_inputs`) and its
-    record; as given without one. With one, the start "auto" is uniform: one actuator's own
-    monitor, whose table would serve few diagnoses for its 9 s build (docs/identification.md §3)."""
-    if baseline is None:
-        return s, params, calibration, uq_calibration, thresholds, None
-    from ..baseline import baseline_inputs
-
-    b = baseline_inputs(baseline, params=params, calibration=calibration, uq_calibration=uq_calibration,
-                        thresholds=thresholds)  # fmt: skip
-    return (
-        s.replace(start="random") if s.start == "auto" else s,  # recorded so
-        b["params"],
-        b["calibration"],
-        b["uq_calibration"],
-        b["thresholds"],
-        {**b["record"], "current_gain": b["current_gain"]},
-    )
 
 
 def _inputs(
@@ -193,11 +171,13 @@ def _intervals(
     on_step: OnGeneration | None,
     warnings: list[str],
     params: Any = None,
+    balanced: tuple[float, str] = (0.0, ""),
 ) -> Uncertainty | None:
     """Stage 6: the Laplace intervals about the estimate (with ``mcmc``, the posterior's from
     them), widened for what the actuator's constants may move (`uncertainty.constants`: a
-    baseline's fit, else the actuator file `params`' tolerances); what makes them doubtful is
-    appended to `warnings`."""
+    baseline's fit, else the actuator file `params`' tolerances) and the shorts' lower ends for
+    the `balanced` part a ψ_m off its nameplate may explain (`uncertainty.balanced`); what makes
+    them doubtful is appended to `warnings`."""
     from .uncertainty import laplace
     from .uncertainty.constants import constants_covariance
 
@@ -219,6 +199,7 @@ def _intervals(
         if interval is not None and s.uncertainty == "mcmc":
             interval = _posterior(ident, interval, factors, seed, on_step, warnings)
     if interval is not None:
+        interval = lower(interval, ident.faults_, *balanced)
         interval.details["wall_time_s"] = round(time.perf_counter() - start, 4)
     return interval
 

@@ -175,17 +175,24 @@ def verdict_of(fit_nrmse: float | None, doubts: list[str]) -> str:
 
 
 def judge(
-    faults: np.ndarray, fit_nrmse: float, interval: Uncertainty | None, thresholds: dict[str, float] | None
+    faults: np.ndarray,
+    fit_nrmse: float,
+    interval: Uncertainty | None,
+    thresholds: dict[str, float] | None,
+    balanced: float = 0.0,
 ) -> tuple[list[str], dict[str, str] | None]:
     """The faults detected and, with intervals, the verdict per fault ("present", "absent",
     "cannot tell"); none when the fit does not explain the recording. `thresholds` overrides the
-    shipped detection thresholds ({} reports nothing)."""
+    shipped detection thresholds ({} reports nothing). Without intervals the point rule judges the
+    shorts less the balanced part `balanced` a ψ_m off its nameplate may explain
+    (`uncertainty.balanced`; with intervals, their lower ends hold it)."""
     from .uncertainty import verdicts
+    from .uncertainty.balanced import discounted
 
     limits_ = thresholds if thresholds is not None else load_thresholds()["thresholds"]
     if not explains(fit_nrmse):
         return [], None
     if interval is None:
-        return detect(faults, limits_), None
+        return detect(discounted(faults, balanced), limits_), None
     judged = verdicts(faults, interval.ci90_low, interval.ci90_high, limits_)
     return [name for name, v in judged.items() if v == "present"], judged

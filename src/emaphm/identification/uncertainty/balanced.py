@@ -1,0 +1,112 @@
+"""A magnet flux below its nameplate reads as a short in every phase (issue 34, item 2).
+
+The monitor's current needs k_t,eq ∝ ψ_m: an actuator whose ψ_m is δ below the nameplate draws
+δ more current for the same torque, and the monitor, whose ψ_m is the nameplate's, explains that
+by shorting turns in all three phases (a short of n turns weakens that phase's flux by n).
+Measured (`python studies/psi_m_as_shorts.py`, `studies/psi_m_profile.py`): a healthy twin with
+ψ_m −2 % reads shorts 0.025 / 0.008 / 0.021, one with ψ_m −1.6 % (and R_s +1.7 %) 0.032 / 0.023 /
+0.030, with short A "present" and verdict "fits"; a true balanced short of 0.02 reads 0.021 /
+0.013 / 0.026. Refitting with monitors whose ψ_m is 0.97–1.02 × the nameplate's moves the
+shorts by about 1.5 × the flux's change while the fit's NRMSE stays within its search noise
+(1.46–1.60 % on the −1.6 % twin): the recording does not hold ψ_m. A baseline does: it fits
+k_t,eq and k_e,eq on the healthy actuator (`emaphm baseline`). Without one, the linearised
+widening of the constants (`constants.shift_covariance`) gives the shorts only about one phase's
+share of it (σ 0.002 / 0.012 / 0.027 on the −1.6 % twin).
+
+So, without a baseline and with a ψ_m tolerance T (the actuator file's ``[tolerances] psi_m``,
+±2 % by default), each short may hold a balanced part of up to the `allowance`
+β = `SLOPE` · `BAND` · T (0.024 by default; `BAND`: ψ_m is more than 0.8 T below its nameplate
+with probability 0.1 in the uniform band). Where every short reads at least `CONSISTENT` (the
+estimate is what a lower ψ_m gives; one phase near 0 rules that out), `lower` takes
+min(k̂_i, β) off each short's lower 90 % end, so that a short whose presence rests on that part is
+"cannot tell", not "present". A result whose three shorts are all within 2β (`doubts`) is
+"doubtful": all it finds in the windings may be the magnet's.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...errors import Doubt
+from ...faults import FAULT_NAMES
+
+if TYPE_CHECKING:
+    from .intervals import Uncertainty
+
+__all__ = ["BAND", "CONSISTENT", "SHORTS", "SLOPE", "allowance", "discounted", "doubts", "lower"]
+
+SHORTS = tuple(FAULT_NAMES.index(n) for n in ("short_a", "short_b", "short_c"))
+SLOPE = 1.5  # the balanced short per relative change of ψ_m (the module docstring: 1.25-2 measured)
+BAND = 0.8  # the one-sided 90 % point of a uniform band ±T, in units of T
+CONSISTENT = 0.004  # every short reads at least this when ψ_m is low by 1 % (short B reads least)
+
+
+def allowance(params: Any, baseline: bool) -> tuple[float, str]:
+    """β: how much of each short a ψ_m within the actuator file `params`' tolerance (an
+    `EmaParams` or none: the defaults) may explain, and where it comes from; 0 with a `baseline`,
+    which fits the flux."""
+    if baseline:
+        return 0.0, "the baseline's fitted k_t,eq and k_e,eq"
+    from ...constants import load_tolerances
+
+    path = params if isinstance(params, (str, os.PathLike)) else None
+    t = load_tolerances(path)["psi_m"]
+    return SLOPE * BAND * t, f"psi_m ±{100 * t:g} % ({f'the tolerances of {path}' if path else 'the default tolerances'})"
+
+
+def _balanced(k_hat: ArrayLike, beta: float) -> np.ndarray | None:
+    """min(k̂_i, β) per short, or None when the shorts are not what a lower ψ_m gives."""
+    shorts = np.asarray(k_hat, dtype=np.float64)[list(SHORTS)]
+    if not beta > 0 or not np.all(shorts >= CONSISTENT):
+        return None
+    return np.minimum(shorts, beta)
+
+
+def discounted(k_hat: ArrayLike, beta: float) -> np.ndarray:
+    """k̂ with each short's balanced part taken off: what the point rule (`detection.detect`)
+    judges without intervals."""
+    k = np.array(k_hat, dtype=np.float64, copy=True)
+    part = _balanced(k, beta)
+    if part is not None:
+        k[list(SHORTS)] -= part
+    return k
+
+
+def lower(interval: Uncertainty, k_hat: ArrayLike, beta: float, source: str) -> Uncertainty:
+    """`interval` with each short's lower 90 % end lowered by its balanced part (the module
+    docstring), recorded in ``details["balanced_allowance"]``; unchanged when there is none."""
+    part = _balanced(k_hat, beta)
+    record = {"beta": round(beta, 5), "source": source, "lowered_by": None}
+    if part is None:
+        return replace(interval, details={**interval.details, "balanced_allowance": record})
+    low = np.array(interval.ci90_low, dtype=np.float64, copy=True)
+    low[list(SHORTS)] = np.maximum(low[list(SHORTS)] - part, 0.0)
+    record["lowered_by"] = [round(float(v), 5) for v in part]
+    return replace(interval, ci90_low=low, details={**interval.details, "balanced_allowance": record})
+
+
+def doubts(k_hat: ArrayLike, beta: float, source: str, thresholds: dict[str, float] | None) -> list[str]:
+    """The reason for "doubtful" a balanced part gives: every short within 2β and one beyond its
+    detection threshold (`thresholds`; None: the shipped ones), else there is nothing found to doubt."""
+    if thresholds is None:
+        from ..detection import load_thresholds
+
+        thresholds = load_thresholds()["thresholds"]
+    part = _balanced(k_hat, beta)
+    shorts = np.asarray(k_hat, dtype=np.float64)[list(SHORTS)]
+    if part is None or not np.all(shorts <= 2.0 * beta):
+        return []
+    if not any(v > thresholds.get(FAULT_NAMES[i], np.inf) for i, v in zip(SHORTS, shorts, strict=True)):
+        return []
+    return [
+        Doubt(
+            f"every phase reads a small short ({', '.join(f'{v:.3f}' for v in shorts)}), as a magnet flux up to "
+            f"{100 * beta / SLOPE:.1f} % below its nameplate would ({source}): without a baseline the two cannot "
+            "be told apart; record one when the actuator is healthy ('emaphm baseline')"
+        )
+    ]
