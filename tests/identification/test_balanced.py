@@ -13,7 +13,7 @@ from emaphm.actuator import resolve_params
 from emaphm.faults import FAULT_NAMES, HEALTHY
 from emaphm.identification.uncertainty import Uncertainty
 from emaphm.identification.uncertainty.balanced import (
-    BAND, CONSISTENT, SHORTS, SLOPE, allowance, discounted, doubts, lower,
+    BAND, CONSISTENT, SHORTS, SLOPE, allowance, discounted, doubts, widen,
 )  # fmt: skip
 from emaphm.models import HighFidelityEma
 
@@ -46,33 +46,47 @@ def test_the_allowance_follows_the_flux_tolerance_and_a_baseline_removes_it(tmp_
 def test_shorts_in_every_phase_lose_their_balanced_part_one_healthy_phase_keeps_them():
     beta = 0.024
     k = _faults((0.02, 0.007, 0.03))  # what a healthy actuator with psi_m -1.6 % reads
-    got = lower(_interval(k), k, beta, "test")
+    got = widen(_interval(k), k, beta, "test")
     low = np.array(got.ci90_low)
     # each short's lower end drops by min(k, beta): the first two reach 0, the third keeps 0.03 - 0.008 - 0.024
     assert low[list(SHORTS)] == pytest.approx([0.0, 0.0, 0.0])
     assert got.details["balanced_allowance"]["lowered_by"] == pytest.approx([0.02, 0.007, 0.024])
-    # the other faults and the upper ends are untouched
+    assert got.details["balanced_allowance"]["low_before"] == pytest.approx([0.012, 0.0, 0.022])
+    # the other faults are untouched; each short's upper end rises by beta (a flux above its nameplate)
     others = [j for j in range(8) if j not in SHORTS]
     assert np.array_equal(low[others], _interval(k).ci90_low[others])
-    assert np.array_equal(got.ci90_high, _interval(k).ci90_high)
+    assert np.array_equal(got.ci90_high[others], _interval(k).ci90_high[others])
+    assert got.ci90_high[list(SHORTS)] == pytest.approx(_interval(k).ci90_high[list(SHORTS)] + beta)
     # a large short keeps all but beta of its lower end
     k2 = _faults((0.02, 0.3, 0.02))
-    assert lower(_interval(k2), k2, beta, "t").ci90_low[SHORTS[1]] == pytest.approx(0.3 - 0.008 - beta)
-    # one phase near 0 rules a lower flux out: nothing changes
+    assert widen(_interval(k2), k2, beta, "t").ci90_low[SHORTS[1]] == pytest.approx(0.3 - 0.008 - beta)
+    # one phase near 0 rules a lower flux out: the lower ends stay, the upper ones still rise
     k3 = _faults((0.02, CONSISTENT / 2, 0.03))
-    assert np.array_equal(lower(_interval(k3), k3, beta, "t").ci90_low, _interval(k3).ci90_low)
+    kept = widen(_interval(k3), k3, beta, "t")
+    assert np.array_equal(kept.ci90_low, _interval(k3).ci90_low)
+    assert kept.ci90_high[SHORTS[1]] == pytest.approx(CONSISTENT / 2 + 0.008 + beta)
+    assert kept.details["balanced_allowance"]["lowered_by"] is None
+    # no allowance (a baseline): nothing moves
+    same = widen(_interval(k), k, 0.0, "t")
+    assert np.array_equal(same.ci90_low, _interval(k).ci90_low) and np.array_equal(same.ci90_high, _interval(k).ci90_high)
     assert np.array_equal(discounted(k3, beta), k3)
     assert discounted(k, beta)[list(SHORTS)] == pytest.approx([0.0, 0.0, 0.006])
 
 
 def test_a_result_whose_shorts_all_fit_the_flux_is_doubtful_and_only_then():
     beta = 0.024
-    (reason,) = doubts(_faults((0.02, 0.007, 0.03)), beta, "psi_m ±2 %", THRESHOLDS)
+    k = _faults((0.02, 0.007, 0.03))
+    (reason,) = doubts(k, beta, "psi_m ±2 %", THRESHOLDS, None)  # the point rule would report short A
     assert isinstance(reason, emaphm.errors.Doubt) and "emaphm baseline" in reason and "1.6 %" in reason
-    assert doubts(_faults((0.02, 0.3, 0.02)), beta, "s", THRESHOLDS) == []  # a real short beyond 2 beta
-    assert doubts(_faults((0.005, 0.006, 0.005)), beta, "s", THRESHOLDS) == []  # none beyond its threshold
-    assert doubts(_faults((0.02, 0.0, 0.03)), beta, "s", THRESHOLDS) == []  # a healthy phase
-    assert doubts(_faults((0.02, 0.007, 0.03)), 0.0, "s", THRESHOLDS) == []  # a baseline: no allowance
+    # with intervals: doubtful when the allowance took a "present" away (short A's 0.012 > 0.0074) ...
+    assert len(doubts(k, beta, "s", THRESHOLDS, widen(_interval(k), k, beta, "s"))) == 1
+    # ... not when no short was "present" before it (every lower end within its threshold)
+    wide = widen(_interval(k, half=0.025), k, beta, "s")
+    assert doubts(k, beta, "s", THRESHOLDS, wide) == []
+    assert doubts(_faults((0.02, 0.3, 0.02)), beta, "s", THRESHOLDS, None) == []  # a real short beyond 2 beta
+    assert doubts(_faults((0.005, 0.006, 0.005)), beta, "s", THRESHOLDS, None) == []  # none beyond its threshold
+    assert doubts(_faults((0.02, 0.0, 0.03)), beta, "s", THRESHOLDS, None) == []  # a healthy phase
+    assert doubts(k, 0.0, "s", THRESHOLDS, None) == []  # a baseline: no allowance
 
 
 @pytest.mark.slow
@@ -85,4 +99,4 @@ def test_a_weaker_magnet_is_not_reported_as_three_shorts():
     assert not any(n.startswith("short") for n in r.detected)
     assert r.uncertainty.details["balanced_allowance"]["lowered_by"] is not None
     # the same recording with no flux tolerance: the shorts are what the monitor found
-    assert doubts(r.estimate, 0.0, "s", None) == []
+    assert doubts(r.estimate, 0.0, "s", None, r.uncertainty) == []

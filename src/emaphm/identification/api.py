@@ -33,7 +33,7 @@ from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult
 from .settings import IdentifySettings
 from .uncertainty import Factors, Uncertainty, load_factors
-from .uncertainty.balanced import allowance, lower
+from .uncertainty.balanced import allowance, widen
 from .uncertainty.balanced import doubts as balanced_doubts
 from .verdict import explains, fit_doubts, fit_limit, fit_warnings, judge, recording_warnings
 
@@ -103,7 +103,7 @@ def identify(
     if explains(ident.fit_nrmse_):
         with numba_threads(s.workers):
             doubted, checked = estimate_doubts(ident.context_, ident.faults_, detected, m.trace.t, m.theta_u, params)
-        warnings += doubted + balanced_doubts(ident.faults_, *balanced, thresholds)
+        warnings += doubted + balanced_doubts(ident.faults_, *balanced, thresholds, interval)
     doubts = [str(w) for w in warnings if isinstance(w, Doubt)]
     doubts += [w for w in (m.conversion or {}).get("doubts", []) if w not in doubts]  # a converted file's
     record = _record(s, ident, m, noise_seed, opt_seed, monitor, factors, params, calibration, uq_calibration)
@@ -175,8 +175,8 @@ def _intervals(
 ) -> Uncertainty | None:
     """Stage 6: the Laplace intervals about the estimate (with ``mcmc``, the posterior's from
     them), widened for what the actuator's constants may move (`uncertainty.constants`: a
-    baseline's fit, else the actuator file `params`' tolerances) and the shorts' lower ends for
-    the `balanced` part a ψ_m off its nameplate may explain (`uncertainty.balanced`); what makes
+    baseline's fit, else the actuator file `params`' tolerances) and the shorts' for the
+    `balanced` part a ψ_m off its nameplate may explain (`uncertainty.balanced`); what makes
     them doubtful is appended to `warnings`."""
     from .uncertainty import laplace
     from .uncertainty.constants import constants_covariance
@@ -199,7 +199,7 @@ def _intervals(
         if interval is not None and s.uncertainty == "mcmc":
             interval = _posterior(ident, interval, factors, seed, on_step, warnings)
     if interval is not None:
-        interval = lower(interval, ident.faults_, *balanced)
+        interval = widen(interval, ident.faults_, *balanced)
         interval.details["wall_time_s"] = round(time.perf_counter() - start, 4)
     return interval
 
