@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -11,11 +12,13 @@ import pytest
 import emaphm
 from emaphm.actuator import load_params
 from emaphm.baseline import FILES, baseline, make_baseline
-from emaphm.calibration import load_calibration
+from emaphm.baseline.files import NAMEPLATE_FILES
+from emaphm.calibration import load_calibration, params_hash
 from emaphm.errors import InputError
 from emaphm.identification.uncertainty import load_factors
 from emaphm.identification.verdict import fit_limit
 from emaphm.models import MonitorEma
+from emaphm.params import EmaParams
 from emaphm.results import SimResult
 from tests.helpers import run_cli
 
@@ -68,6 +71,10 @@ def test_the_folder_holds_what_identify_needs_bound_together(folder):
     # the constants' covariance, which widens each diagnosis' intervals: positive definite on the fitted ones
     cov = np.array(factors.record["constants"]["log_covariance"])
     assert cov.shape == (7, 7) and np.all(np.linalg.eigvalsh(cov) > 0)
+    # the nameplate and its own calibration, for the start table the type shares
+    nameplate = load_params(folder / NAMEPLATE_FILES["params"])
+    assert params_hash(nameplate) == params_hash(EmaParams()) != params_hash(params)
+    MonitorEma(nameplate, calibration=load_calibration(folder / NAMEPLATE_FILES["calibration"]))
     text = (folder / FILES["params"]).read_text()
     assert "current sensor's gain" in text and "90 % interval" in text and "sha256" in text
     assert "<table>" in (folder / "index.html").read_text()
@@ -84,9 +91,27 @@ def test_identify_with_the_baseline_reads_the_short_right_where_the_nameplate_do
     assert based.settings["baseline"]["directory"] == str(folder) and based.settings["baseline"]["current_gain"] > 1.04
     assert alone.settings["baseline"] is None
     assert based.uncertainty.details["constants_from"].startswith("the baseline's fit")
-    # one actuator's own monitor: "auto" starts uniform (a table would serve few diagnoses), recorded so
-    assert alone.settings["stages"][0]["start"] == "table"
-    assert based.settings["stages"][0]["start"] == "random" and based.settings["identify"]["start"] == "random"
+    # the search starts from the nameplate's table, the one every actuator of the type shares
+    assert alone.settings["stages"][0]["start"] == based.settings["stages"][0]["start"] == "table"
+    assert based.settings["stages"][0]["table"] == alone.settings["stages"][0]["table"]
+    assert based.settings["baseline"]["table_from"]["params"] == str(folder / NAMEPLATE_FILES["params"])
+
+
+def test_a_folder_without_the_nameplate_starts_uniform(folder, tmp_path):
+    # a folder made before the nameplate's files were written: "auto" is a uniform start, recorded so
+    old = tmp_path / "old"
+    shutil.copytree(folder, old)
+    for name in NAMEPLATE_FILES.values():
+        (old / name).unlink()
+    quick = {"seed": 1, "pop_size": 8, "generations": 2, "polish": False, "last_stage": "none", "uncertainty": "none"}
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, baseline=old, **quick)
+    assert r.settings["stages"][0]["start"] == "random" and r.settings["identify"]["start"] == "random"
+    assert r.settings["baseline"]["table_from"] is None
+    # a nameplate calibration that is not the nameplate's (another actuator's): the same, no refusal
+    shutil.copy(folder / FILES["calibration"], old / NAMEPLATE_FILES["calibration"])
+    shutil.copy(folder / NAMEPLATE_FILES["params"], old / NAMEPLATE_FILES["params"])
+    r = emaphm.identify(true_faults=emaphm.HEALTHY, baseline=old, **quick)
+    assert r.settings["stages"][0]["start"] == "random" and r.settings["baseline"]["table_from"] is None
 
 
 def test_recordings_of_two_actuators_are_refused_with_the_reason(healthy, tmp_path):

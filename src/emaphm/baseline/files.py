@@ -8,6 +8,10 @@
                       from the actuator, which a few per cent on the constants do not change),
                       bound to this calibration, with the baseline's own fits
     detection.json    the detection thresholds (the nameplate's)
+    nameplate.toml, nameplate-calibration.json   the nameplate and its own monitor calibration,
+                      whose start table the search starts from (one table for every actuator of
+                      the type; absent when the calibration was another actuator's, and in
+                      folders made before them: the search then starts uniform)
     baseline.json     the record: the recordings and their SHA-256, the factors with their
                       intervals, each recording's fit, the settings and versions
     index.html, fit-N.png   a short report
@@ -35,12 +39,13 @@ from ..identification.uncertainty import Factors, load_factors
 from .fit import CONSTANTS
 from .make import Baseline
 
-__all__ = ["FILES", "baseline_files", "baseline_inputs", "check_output_dir", "write_baseline"]
+__all__ = ["FILES", "NAMEPLATE_FILES", "baseline_files", "baseline_inputs", "check_output_dir", "write_baseline"]
 
 FILES = {
     "params": "actuator.toml", "calibration": "calibration.json", "uq_calibration": "uq.json",
     "detection": "detection.json", "record": "baseline.json",
 }  # fmt: skip
+NAMEPLATE_FILES = {"params": "nameplate.toml", "calibration": "nameplate-calibration.json"}  # optional
 _WHAT = {
     "i_gain": "the current sensor's gain (identify divides the current by it)",
     "k_t_eq": "the monitor's torque gain k_t,eq", "k_e_eq": "the back-EMF gain k_e,eq (psi_m)",
@@ -95,7 +100,24 @@ def baseline_inputs(directory: str | os.PathLike[str], **given: Any) -> dict[str
         "current_gain": float(record.get("factors", {}).get("i_gain", {}).get("factor", 1.0)),
         "record": {"directory": str(directory), "created": record.get("created"), "sha256": sha256_of(files["record"]),
                    "params_hash": record.get("params_hash"), "recordings": [r.get("file") for r in record.get("recordings", [])]},
+        "table_from": _nameplate(Path(directory)),
     }  # fmt: skip
+
+
+def _nameplate(directory: Path) -> dict[str, str] | None:
+    """The nameplate's files whose start table the search starts from, or None: not in the folder,
+    or not a calibration of that nameplate (a start only: the search then starts uniform)."""
+    from ..actuator import load_params
+    from ..models import MonitorEma
+
+    paths = {role: directory / name for role, name in NAMEPLATE_FILES.items()}
+    if not all(p.is_file() for p in paths.values()):
+        return None
+    try:
+        MonitorEma(load_params(paths["params"]), calibration=paths["calibration"])
+    except InputError:
+        return None
+    return {role: str(p) for role, p in paths.items()}
 
 
 def write_baseline(
@@ -112,6 +134,9 @@ def write_baseline(
         tmp = Path(tmp_name)
         (tmp / FILES["params"]).write_text(_actuator_text(made, created))
         calibration.save(tmp / FILES["calibration"])
+        if made.nameplate_calibration is not None:
+            (tmp / NAMEPLATE_FILES["params"]).write_text(params_template(made.nameplate))
+            made.nameplate_calibration.save(tmp / NAMEPLATE_FILES["calibration"])
         _uq(made, calibration, uq_calibration).save(tmp / FILES["uq_calibration"])
         thresholds = dict(load_thresholds(detection))
         (tmp / FILES["detection"]).write_text(json.dumps(

@@ -47,9 +47,13 @@ class Baseline:
     recording's context and monitor current at the baseline's constants (`currents`, for the report)."""
 
     def __init__(self, params: Any, calibration: Calibration, fit: BaselineFit, record: dict[str, Any],
-                 nameplate: Any, contexts: list[Any], currents: list[Any]) -> None:  # fmt: skip
+                 nameplate: Any, contexts: list[Any], currents: list[Any],
+                 nameplate_calibration: Calibration | None = None) -> None:  # fmt: skip
         self.params, self.calibration, self.fit, self.record = params, calibration, fit, record
         self.nameplate, self.contexts, self.currents = nameplate, contexts, currents
+        # the nameplate's own monitor calibration (None: a warm start from another actuator's), whose
+        # start table every actuator of the type shares (`identify --baseline`)
+        self.nameplate_calibration = nameplate_calibration
 
 
 def make_baseline(
@@ -105,7 +109,7 @@ def make_baseline(
         "fit": fit.details,
         "wall_time_s": round(time.perf_counter() - start, 2),
     }  # fmt: skip
-    return Baseline(fitted, cal, fit, record, nameplate, contexts, currents)
+    return Baseline(fitted, cal, fit, record, nameplate, contexts, currents, None if warm else monitor.calibration)
 
 
 def _monitor(nameplate: Any, calibration: Any) -> tuple[MonitorEma, str | None]:

@@ -60,6 +60,9 @@ class Context:
     doubtful_nrmse: float | None = None
     # progress of work that is not a generation (label, done, total): the start table's build
     on_progress: Progress | None = None
+    # the monitor whose start table the search starts from (a baseline's nameplate, under the same
+    # command; None: `monitor`): every actuator of a type shares its table (`start_table`)
+    table_monitor: MonitorEma | None = None
 
     def with_seed(self, seed: int) -> Context:
         """The same comparison searched from another optimiser seed (`second_search`)."""

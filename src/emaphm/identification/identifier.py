@@ -14,6 +14,7 @@ Uncertainty (6, `uncertainty`) and the verdict (7, `verdict`) follow in `api.ide
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -55,6 +56,9 @@ class FaultIdentifier:
         starts from it where it is below the monitor's trigger (`limits.SECOND_SEARCH_NRMSE`).
     on_progress : callable(label, done, total), optional
         Progress of work that is not a generation: the start table's build (`start_table`).
+    table_monitor : MonitorEma, optional
+        The monitor whose start table the search starts from (a baseline's nameplate; default the
+        search's own).
 
     After `prepare`: ``context_`` (`context.Context`) and, from it, ``monitor_``, ``duration_``
     [s], ``reference_``, ``whole_``, ``mask_``, ``compared_``, ``above_band_``,
@@ -74,6 +78,7 @@ class FaultIdentifier:
         on_generation: OnGeneration | None = None,
         doubtful_nrmse: float | None = None,
         on_progress: Progress | None = None,
+        table_monitor: MonitorEma | None = None,
         **options: Any,
     ) -> None:
         if isinstance(monitor, str):  # the monitor by name: the settings' field (docs/conventions.md)
@@ -87,6 +92,7 @@ class FaultIdentifier:
         self.on_generation = on_generation
         self.doubtful_nrmse = doubtful_nrmse
         self.on_progress = on_progress
+        self.table_monitor = table_monitor
 
     def prepare(
         self, t: ArrayLike, i_q: ArrayLike, command: Command | None = None, theta_u: ArrayLike | None = None
@@ -97,6 +103,9 @@ class FaultIdentifier:
         ctx = prepare(t, i_q, command, theta_u, settings=self.settings, monitor=self.monitor,
                       on_generation=self.on_generation, doubtful_nrmse=self.doubtful_nrmse,
                       on_progress=self.on_progress)  # fmt: skip
+        if self.table_monitor is not None:  # under the recording's command, as the context's
+            tm = self.table_monitor
+            ctx = replace(ctx, table_monitor=MonitorEma(tm.params, ctx.monitor.command, tm.calibration, allow_mismatch=True))
         self.context_: Context = ctx
         self.monitor_, self.duration_, self.reference_, self.whole_ = (
             ctx.monitor,

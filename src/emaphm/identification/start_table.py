@@ -27,8 +27,8 @@ compared span, the comparison filter, the kernels' sources and the table's own l
 else ``$XDG_CACHE_HOME/emaphm/start-tables`` (``~/.cache/...``); one is built the first time its
 key is asked for (16 384 monitor runs: 8-11 s on a shared 2-core machine) and written atomically; where no
 folder can be written it is built in memory for the process. The folder is bounded (`prune`: the
-least recently used tables go beyond ``$EMAPHM_TABLE_CACHE_MB``, 2 GiB by default), since every
-actuator with its own baseline has a table of its own.
+least recently used tables go beyond ``$EMAPHM_TABLE_CACHE_MB``, 2 GiB by default). A baselined
+actuator starts from its nameplate's table (``Context.table_monitor``), shared by its type.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from __future__ import annotations
 import hashlib
 import os
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -76,7 +76,7 @@ RANK_CHUNK = 512
 MEMORY_TABLES = 4  # tables a process keeps in memory (33 MB each), the most recently used
 # the table folder is kept under this many MiB (``$EMAPHM_TABLE_CACHE_MB``; 0: no bound): after a
 # table is written, the least recently used ones go (`prune`); a table gone is built again, the same.
-# 2 GiB holds about 120 tables of the 1 s chirp, a fleet of baselined actuators needs one each
+# 2 GiB holds about 120 tables of the 1 s chirp (one per actuator type, calibration and command)
 TABLE_CACHE_MB = 2048
 
 
@@ -289,9 +289,11 @@ def uses_table(context: Context) -> NDArray[np.float64] | None:
 def first_population(
     context: Context, theta_cmd: NDArray[np.float64], pop_size: int, on_progress: Progress | None = None
 ) -> tuple[NDArray[np.float64], dict[str, object]]:
-    """The GA's first population from the context's table under `theta_cmd` (`StartTable.ranked`)
-    and what to record of it."""
-    table, built = start_table(context, theta_cmd, on_progress)
+    """The GA's first population from the context's table under `theta_cmd` (`StartTable.ranked`;
+    the table of its ``table_monitor`` when it has one: a baseline's nameplate) and what to record
+    of it."""
+    source = context if context.table_monitor is None else replace(context, monitor=context.table_monitor)
+    table, built = start_table(source, theta_cmd, on_progress)
     X = table.ranked(context.reference.reference, context.objective.weights, pop_size)
     return X, {"table": table.key[:16], "table_rows": int(len(table.X)), "table_built": built}
 
