@@ -1,6 +1,6 @@
 """Issue 34: which of a drawn actuator's constants moves the estimate, and does the monitor know it?
 
-    python studies/tolerance_sensitivity.py [--case 8] [--seed 1] [--case-seed 3307]
+    python studies/tolerance_sensitivity.py [--case 8] [--seed 1] [--case-seed 3307] [--across 8]
 
 One run of ``benchmarks/bench_foc.py --tolerance 0.02 --case-seed 3307`` (its case `--case`, seed
 `--seed`: the same drawn actuator and noise), identified as that benchmark does with the
@@ -10,6 +10,11 @@ run's friction k1 and k_P drift k8 against the truth, with k1's interval. Then t
 answer to the same F_D0 change: its current at the truth with F_D0 scaled, identified by the
 nameplate's monitor (no twin, no noise): what the linearised widening for the constants
 (`identification/uncertainty/constants.py`) rests on.
+
+Then, over `--across` random cases (seed 4401, nameplate actuator), F_D0 −2 % alone: the change
+of k1 on the twin (the same noise seed with and without it) against the monitor's own change and
+the scaling law. One case's ratio is not the drive's: the twin's changes include the search's
+scatter between two recordings.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--case", type=int, default=8)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--case-seed", type=int, default=3307)
+    parser.add_argument("--across", type=int, default=8, help="random cases for F_D0 -2 %% alone (0: none)")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
     from _cases import CALIBRATION_COMMANDS, draw_cases, drawn_actuator, noise_seed_of, resolve_params
@@ -66,6 +72,36 @@ def main(argv: list[str] | None = None) -> None:
     print(f"the monitor's own current with F_D0 {100 * ratio['F_D0']:+.2f} %: k1 {r.estimate[0]:.4f} "
           f"({r.estimate[0] - k[0]:+.4f}; the scaling F_D = F_D0 (1 + 2 k1) gives "
           f"{ratio['F_D0'] * (1 + 2 * k[0]) / 2:+.4f})")
+    _across(args.across, nameplate, calibration)
+
+
+def _across(n: int, nameplate, calibration) -> None:  # noqa: ANN001
+    """F_D0 −2 % alone on `n` random cases: the twin's change of k1 against the monitor's (the docstring)."""
+    import numpy as np
+    from _cases import CALIBRATION_COMMANDS, draw_cases, noise_seed_of
+
+    import emaphm
+    from emaphm.constants import apply
+    from emaphm.models import MonitorEma
+
+    params, cal = apply(nameplate, calibration, {"F_D0": 0.98})
+    lowered = MonitorEma(params, calibration=dc.replace(cal, record={
+        **cal.record, "settings": {**cal.record.get("settings", {}), "params": params.to_dict()}}))  # fmt: skip
+    plant = dc.replace(nameplate, transmission=dc.replace(nameplate.transmission, F_D0=0.98 * nameplate.transmission.F_D0))
+    ratios = []
+    for j, k in enumerate(draw_cases(n, 4401) if n else []):
+        def k1(reference, **kw):  # noqa: ANN001, ANN003, ANN202
+            return emaphm.identify(reference=reference, seed=1, uncertainty="none", **kw).estimate[0]
+
+        twin = [k1(emaphm.HighFidelityEma(p, CALIBRATION_COMMANDS["chirp"]).simulate(k, seed=noise_seed_of(1)))
+                for p in (nameplate, plant)]  # fmt: skip
+        mon = [k1(m.simulate(k), last_stage="none") for m in (MonitorEma(nameplate), lowered)]
+        d_twin, d_mon = twin[1] - twin[0], mon[1] - mon[0]
+        ratios.append(d_twin / d_mon)
+        print(f"case {j} (k1 {k[0]:.3f}): F_D0 -2 % moves k1 by {d_twin:+.4f} on the twin, {d_mon:+.4f} in the "
+              f"monitor (scaling {-0.02 * (1 + 2 * k[0]) / 2:+.4f}): {ratios[-1]:.2f} x", flush=True)  # fmt: skip
+    if ratios:
+        print(f"twin / monitor over {len(ratios)} cases: median {np.median(ratios):.2f}, {min(ratios):.2f} to {max(ratios):.2f}")
 
 
 if __name__ == "__main__":
