@@ -100,3 +100,21 @@ def test_a_weaker_magnet_is_not_reported_as_three_shorts():
     assert r.uncertainty.details["balanced_allowance"]["lowered_by"] is not None
     # the same recording with no flux tolerance: the shorts are what the monitor found
     assert doubts(r.estimate, 0.0, "s", None, r.uncertainty) == []
+
+
+def test_the_interval_calibration_fits_the_factors_to_the_intervals_with_the_allowance():
+    from emaphm.identification.uncertainty import fit_factors
+
+    rng = np.random.default_rng(3)
+    T = rng.uniform(0.05, 0.5, size=(60, 8))
+    T[:, 6], T[:, 5] = rng.uniform(0, 1, 60), 0.2
+    E = T.copy()
+    E[:, list(SHORTS)] -= 0.02  # every short read low, as a flux above its nameplate reads them
+    S = np.full_like(E, 0.005)
+    plain, _ = fit_factors(E, S, T)
+    allowed_for, _ = fit_factors(E, S, T, balanced=0.024)
+    for j in SHORTS:
+        # without the allowance the scale must reach 0.02 / (1.645 * 0.005) ~ 2.4 to cover the bias; with it, the grid's bottom
+        assert plain.scale[j] > 2.0 and allowed_for.scale[j] == pytest.approx(0.3)
+    others = [j for j in range(8) if j not in SHORTS]
+    assert np.array_equal(plain.scale[others], allowed_for.scale[others])

@@ -200,6 +200,8 @@ def calibrate_uq(
         cases, seed, calibration=calibration, monitor=monitor, progress=progress, params=actuator,
         drive_tolerance=drive_tolerance, tolerance=tolerance, last_stage=last_stage, start=start,
     )  # fmt: skip
+    # fitted without the shorts' allowance for psi_m (`uncertainty.balanced`): a baselined run, which
+    # has none, uses these factors too; without a baseline the two overlap (wider, not narrower)
     fitted, report = fit_factors(data["estimates"], data["raw_std"], data["truths"], added=data["added_std"])
     record = _record(lf, actuator, data, report, cases=cases, seed=seed, drive_tolerance=drive_tolerance,
                      tolerance=tolerance, wall=time.perf_counter() - began, last_stage=stage, start=start)  # fmt: skip

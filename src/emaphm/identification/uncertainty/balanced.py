@@ -43,7 +43,7 @@ from ...faults import FAULT_NAMES
 if TYPE_CHECKING:
     from .intervals import Uncertainty
 
-__all__ = ["BAND", "CONSISTENT", "SHORTS", "SLOPE", "allowance", "discounted", "doubts", "widen"]
+__all__ = ["BAND", "CONSISTENT", "SHORTS", "SLOPE", "allowance", "allowed", "discounted", "doubts", "widen"]
 
 SHORTS = tuple(FAULT_NAMES.index(n) for n in ("short_a", "short_b", "short_c"))
 SLOPE = 1.5  # the balanced short per relative change of ψ_m (the module docstring: 1.25-2 measured)
@@ -82,24 +82,37 @@ def discounted(k_hat: ArrayLike, beta: float) -> np.ndarray:
     return k
 
 
+def allowed(
+    K: ArrayLike, low: ArrayLike, high: ArrayLike, beta: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The 90 % ends of rows of estimates `K` (m, 8) with the allowance β (the module docstring):
+    (low, high, part), part the balanced part taken off each short's lower end (0 where the row's
+    shorts are not what a lower ψ_m gives). What `widen` and the interval calibration's fit
+    (`factors.fit_factors`) apply alike."""
+    K, lo, hi = (np.array(a, dtype=np.float64, ndmin=2, copy=True) for a in (K, low, high))
+    rows = list(SHORTS)
+    part = np.zeros((len(K), len(rows)))
+    if beta > 0:
+        hi[:, rows] = np.minimum(hi[:, rows] + beta, 1.0)
+        consistent = np.all(K[:, rows] >= CONSISTENT, axis=1)
+        part[consistent] = np.minimum(K[consistent][:, rows], beta)
+        lo[:, rows] = np.maximum(lo[:, rows] - part, 0.0)
+    return lo, hi, part
+
+
 def widen(interval: Uncertainty, k_hat: ArrayLike, beta: float, source: str) -> Uncertainty:
     """`interval` with each short's upper 90 % end raised by β (a flux above its nameplate reads
     every short lower, one at 0 hiding below the bound) and, where every short reads at least
-    `CONSISTENT`, its lower end lowered by its balanced part min(k̂, β) (the module docstring);
-    recorded in ``details["balanced_allowance"]``. Unchanged with β = 0 (a baseline)."""
+    `CONSISTENT`, its lower end lowered by its balanced part min(k̂, β) (`allowed`); recorded in
+    ``details["balanced_allowance"]``. Unchanged with β = 0 (a baseline)."""
     record: dict[str, Any] = {"beta": round(beta, 5), "source": source, "lowered_by": None, "low_before": None}
     if not beta > 0:
         return replace(interval, details={**interval.details, "balanced_allowance": record})
-    rows = list(SHORTS)
-    low = np.array(interval.ci90_low, dtype=np.float64, copy=True)
-    high = np.array(interval.ci90_high, dtype=np.float64, copy=True)
-    high[rows] = np.minimum(high[rows] + beta, 1.0)
-    part = _balanced(k_hat, beta)
-    if part is not None:
-        record["low_before"] = [round(float(v), 5) for v in low[rows]]
-        low[rows] = np.maximum(low[rows] - part, 0.0)
-        record["lowered_by"] = [round(float(v), 5) for v in part]
-    return replace(interval, ci90_low=low, ci90_high=high, details={**interval.details, "balanced_allowance": record})
+    lo, hi, part = allowed(k_hat, interval.ci90_low, interval.ci90_high, beta)
+    if np.any(part > 0):
+        record["low_before"] = [round(float(interval.ci90_low[i]), 5) for i in SHORTS]
+        record["lowered_by"] = [round(float(v), 5) for v in part[0]]
+    return replace(interval, ci90_low=lo[0], ci90_high=hi[0], details={**interval.details, "balanced_allowance": record})
 
 
 def doubts(

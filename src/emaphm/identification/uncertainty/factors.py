@@ -180,12 +180,16 @@ def fit_factors(
     *,
     coverage: float = FIT_COVERAGE,
     added: ArrayLike | None = None,
+    balanced: float = 0.0,
 ) -> tuple[Factors, dict[str, Any]]:
     """The scale and floor per fault that give `coverage` of the 90 % intervals on these cases with
     the narrowest median interval (a grid search; k7 scored only where the true ζ ≥ 0.05, on the
     circle). `added`: each case's σ from the actuator's constants (`constants.shift_covariance`),
-    which the intervals add in quadrature to the calibrated one. Returns the factors and, per
-    fault, the coverage and median half-width reached."""
+    which the intervals add in quadrature to the calibrated one; `balanced`: the shorts' allowance
+    β for a ψ_m off its nameplate that the intervals then carry (`balanced.allowed`). Returns the
+    factors and, per fault, the coverage and median half-width reached."""
+    from .balanced import allowed
+
     E, S, T = (np.array(a, dtype=np.float64, ndmin=2) for a in (estimates, raw_std, truths))
     A = np.zeros_like(S) if added is None else np.array(added, dtype=np.float64, ndmin=2)
     if not (E.shape == S.shape == T.shape and E.shape[1] == N_PARAMS):
@@ -204,6 +208,7 @@ def fit_factors(
             _, lo, hi, _ = intervals(
                 E, np.sqrt(Factors(trial_s, trial_b).apply(S) ** 2 + A**2), with_flags=False
             )
+            lo, hi, _ = allowed(E, lo, hi, balanced)
             cov = float(covers(lo, hi, T)[rows, j].mean())
             width = float(np.median(half_widths(lo, hi)[rows, j]))
             if cov >= coverage and (best is None or width < best[2]):
