@@ -251,6 +251,26 @@ def test_identify_without_uncertainty_gives_null_intervals(capsys):
     )
 
 
+@pytest.mark.slow  # builds a start table, ~10 s
+def test_identify_in_a_log_says_when_it_builds_a_start_table(tmp_path, capsys, monkeypatch):
+    from collections import OrderedDict
+
+    from emaphm.identification import start_table
+
+    monkeypatch.setenv("EMAPHM_TABLE_DIR", str(tmp_path / "tables"))
+    monkeypatch.setattr(start_table, "_MEMORY", OrderedDict())  # none kept from earlier tests
+    args = ["identify", "--true-faults", "0.3,0,0,0,0,0,0,0.5", "--json", "--uncertainty", "none", *FAST,
+            "--start", "table"]  # fmt: skip
+    code, _, err = run_cli(args, capsys)
+    label = "start table (once per actuator and command)"
+    assert code in EXIT_OF_VERDICT.values()
+    assert f"emaphm: {label}: {start_table.TABLE_ROWS} steps" in err and f"emaphm: {label}: done" in err
+    # kept: the next diagnosis reads it and says nothing of it
+    monkeypatch.setattr(start_table, "_MEMORY", OrderedDict())
+    _, _, err = run_cli(args, capsys)
+    assert label not in err
+
+
 @pytest.mark.parametrize(
     ("args", "reason"),
     [

@@ -21,7 +21,7 @@ from .options import (
     settings_from_options,
     with_settings_options,
 )
-from .output import err, progress
+from .output import bracketed, err, progress
 from .render import print_identification
 
 __all__ = ["identify"]
@@ -126,7 +126,7 @@ def identify(
             on_generation=lambda gen, total, best: update(
                 "MCMC steps" if gen < 0 else search_progress_label(settings.optimizer), abs(gen), total
             ),
-            on_progress=update,
+            on_progress=bracketed(update),  # a start table's build: a line at its start and end in a log
         )  # fmt: skip
     data = result.to_json()
     for warning in data["warnings"]:

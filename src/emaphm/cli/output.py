@@ -14,7 +14,7 @@ from typing import Any
 
 from rich.console import Console
 
-__all__ = ["campaign_progress", "err", "logged", "progress", "status", "stdout_console"]
+__all__ = ["bracketed", "campaign_progress", "err", "logged", "progress", "status", "stdout_console"]
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
 
@@ -50,6 +50,25 @@ def progress() -> Iterator[Callable[[str, int, int], None]]:
             bar.update(tasks[stage], completed=done)
 
         yield update
+
+
+def bracketed(update: Callable[[str, int, int], None]) -> Callable[[str, int, int], None]:
+    """`update` (a `progress` bar's) that also prints a line when a stage starts and one when it
+    ends, when stderr is a log, not a terminal: work that is not a generation and may take seconds
+    (a start table's build), which a log would otherwise pass over in silence."""
+    started: set[str] = set()
+
+    def report(stage: str, done: int, total: int) -> None:
+        update(stage, done, total)
+        if err.is_terminal:
+            return
+        if stage not in started:
+            started.add(stage)
+            err.print(f"emaphm: {stage}: {total} steps")
+        if done >= total:
+            err.print(f"emaphm: {stage}: done")
+
+    return report
 
 
 def logged(update: Callable[[str, int, int], None]) -> Callable[[str, int, int], None]:
