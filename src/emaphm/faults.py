@@ -33,6 +33,7 @@ __all__ = [
     "HEALTHY",
     "N_MIN",
     "RANDOM_CASE_RANGES",
+    "SHORTS",
     "TABLE1_REFERENCE",
     "FaultedParameters",
     "apply_faults",
@@ -53,6 +54,8 @@ FAULT_NAMES: tuple[str, ...] = (
     "eccentricity_phase",
     "kp_drift",
 )
+SHORTS: tuple[int, ...] = tuple(FAULT_NAMES.index(n) for n in ("short_a", "short_b", "short_c"))
+"""The indices of the three phases' shorts k3..k5 in the fault vector."""
 FAULT_DESCRIPTIONS: tuple[str, ...] = (
     "dry friction, F = F0·(1 + 2·k1)",
     "backlash, B = B0·(1 + 99·k2)",

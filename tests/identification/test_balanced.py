@@ -10,10 +10,10 @@ import pytest
 
 import emaphm
 from emaphm.actuator import resolve_params
-from emaphm.faults import FAULT_NAMES, HEALTHY
+from emaphm.faults import FAULT_NAMES, HEALTHY, SHORTS
 from emaphm.identification.uncertainty import Uncertainty
 from emaphm.identification.uncertainty.balanced import (
-    BAND, CONSISTENT, SHORTS, SLOPE, allowance, discounted, doubts, widen,
+    BAND, CONSISTENT, SLOPE, allowance, discounted, doubts, widen,
 )  # fmt: skip
 from emaphm.models import HighFidelityEma
 

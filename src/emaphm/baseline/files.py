@@ -80,7 +80,9 @@ def baseline_files(directory: str | os.PathLike[str]) -> dict[str, Path]:
 
 def baseline_inputs(directory: str | os.PathLike[str], **given: Any) -> dict[str, Any]:
     """What `identify` takes from a baseline folder: params, calibration, uq_calibration (paths),
-    thresholds (the detection file's) and ``record`` (which baseline, for the result). `given`:
+    thresholds (the detection file's), ``record`` (which baseline, for the result) and the
+    nameplate's monitor whose start table the search starts from with its files (``table_monitor``,
+    ``table_from``; None in a folder without them). `given`:
     those the caller passed too, each refused (the baseline gives them)."""
     clash = [name for name, value in given.items() if value is not None]
     if clash:
@@ -100,24 +102,26 @@ def baseline_inputs(directory: str | os.PathLike[str], **given: Any) -> dict[str
         "current_gain": float(record.get("factors", {}).get("i_gain", {}).get("factor", 1.0)),
         "record": {"directory": str(directory), "created": record.get("created"), "sha256": sha256_of(files["record"]),
                    "params_hash": record.get("params_hash"), "recordings": [r.get("file") for r in record.get("recordings", [])]},
-        "table_from": _nameplate(Path(directory)),
+        **_nameplate(Path(directory)),
     }  # fmt: skip
 
 
-def _nameplate(directory: Path) -> dict[str, str] | None:
-    """The nameplate's files whose start table the search starts from, or None: not in the folder,
-    or not a calibration of that nameplate (a start only: the search then starts uniform)."""
+def _nameplate(directory: Path) -> dict[str, Any]:
+    """{"table_monitor": the nameplate's monitor, whose start table the search starts from,
+    "table_from": its files}; both None when they are not in the folder or are not a calibration of
+    that nameplate (a start only: the search then starts uniform)."""
     from ..actuator import load_params
     from ..models import MonitorEma
 
     paths = {role: directory / name for role, name in NAMEPLATE_FILES.items()}
+    none = {"table_monitor": None, "table_from": None}
     if not all(p.is_file() for p in paths.values()):
-        return None
+        return none
     try:
-        MonitorEma(load_params(paths["params"]), calibration=paths["calibration"])
+        monitor = MonitorEma(load_params(paths["params"]), calibration=paths["calibration"])
     except InputError:
-        return None
-    return {role: str(p) for role, p in paths.items()}
+        return none
+    return {"table_monitor": monitor, "table_from": {role: str(p) for role, p in paths.items()}}
 
 
 def write_baseline(

@@ -23,7 +23,7 @@ from ..models import MonitorEma
 from ..params import EmaParams
 from ..results import SimResult
 from . import limits
-from .baseline_inputs import divided_by_gain, table_monitor, with_baseline
+from .baseline_inputs import divided_by_gain, with_baseline
 from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
@@ -75,7 +75,7 @@ def identify(
         calibrations and thresholds (then not given otherwise), recorded as ``settings["baseline"]``;
         the search starts from the nameplate's start table the folder names (an older folder: uniform).
     """
-    s, params, calibration, uq_calibration, thresholds, used = with_baseline(
+    s, params, calibration, uq_calibration, thresholds, used, nameplate = with_baseline(
         baseline, IdentifySettings.resolve(settings, options), params, calibration, uq_calibration, thresholds
     )
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
@@ -85,7 +85,7 @@ def identify(
     doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
     balanced = allowance(params, used is not None)  # ψ_m's share of the shorts (`uncertainty.balanced`)
     ident = FaultIdentifier(s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation,
-                            doubtful_nrmse=doubtful[0], on_progress=on_progress, table_monitor=table_monitor(used, s))  # fmt: skip
+                            doubtful_nrmse=doubtful[0], on_progress=on_progress, table_monitor=nameplate)  # fmt: skip
     with numba_threads(s.workers):
         ident.fit(m.trace.t, m.trace.i_q, m.command, m.theta_u)
     warnings = [

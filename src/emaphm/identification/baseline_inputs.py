@@ -7,24 +7,24 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from ..models import MonitorEma
 from ..results import SimResult
 from .recording import Measurement
 from .settings import IdentifySettings
 
-__all__ = ["divided_by_gain", "table_monitor", "with_baseline"]
+__all__ = ["divided_by_gain", "with_baseline"]
 
 
 def with_baseline(
     baseline: Any, s: IdentifySettings, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
 ) -> tuple[Any, ...]:
-    """The settings and the inputs a baseline folder gives (`baseline.baseline_inputs`) and its
-    record (with ``table_from``, the nameplate's files whose start table the search starts from);
-    as given without one. A folder without the nameplate's files (made before them, or from
-    another actuator's calibration) makes the start "auto" uniform: one actuator's own table
-    would serve few diagnoses for its 9 s build (docs/identification.md §3)."""
+    """The settings and the inputs a baseline folder gives (`baseline.baseline_inputs`), its
+    record (with ``table_from``, the nameplate's files) and the nameplate's monitor whose start
+    table the search starts from; as given without one (and no monitor). A folder without the
+    nameplate's files (made before them, or from another actuator's calibration) makes the start
+    "auto" uniform: one actuator's own table would serve few diagnoses for its 9 s build
+    (docs/identification.md §3)."""
     if baseline is None:
-        return s, params, calibration, uq_calibration, thresholds, None
+        return s, params, calibration, uq_calibration, thresholds, None, None
     from ..baseline import baseline_inputs
 
     b = baseline_inputs(baseline, params=params, calibration=calibration, uq_calibration=uq_calibration,
@@ -36,18 +36,8 @@ def with_baseline(
         b["uq_calibration"],
         b["thresholds"],
         {**b["record"], "current_gain": b["current_gain"], "table_from": b["table_from"]},
+        b["table_monitor"],
     )
-
-
-def table_monitor(used: dict[str, Any] | None, s: IdentifySettings) -> MonitorEma | None:
-    """The nameplate's monitor whose start table a baselined search starts from (`with_baseline`'s
-    record ``table_from``), or None: the search's own monitor's."""
-    if used is None or used.get("table_from") is None or s.start == "random":
-        return None
-    from ..actuator import resolve_params
-
-    files = used["table_from"]
-    return MonitorEma(resolve_params(files["params"]), calibration=files["calibration"], monitor=s.monitor)
 
 
 def divided_by_gain(m: Measurement, used: dict[str, Any] | None) -> Measurement:

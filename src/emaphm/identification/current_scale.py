@@ -49,7 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import Doubt
-from ..faults import FAULT_NAMES
+from ..faults import FAULT_NAMES, SHORTS
 from . import limits
 from .context import Context
 from .lm import levenberg_marquardt
@@ -58,7 +58,6 @@ from .problem import phase_in_box, search_to_faults
 
 __all__ = ["current_scale", "scale_doubts", "scale_limit"]
 
-SHORTS = tuple(FAULT_NAMES.index(n) for n in ("short_a", "short_b", "short_c"))
 
 
 def scale_limit(params: Any) -> tuple[float, str]:

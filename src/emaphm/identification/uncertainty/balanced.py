@@ -23,9 +23,9 @@ min(k̂_i, β) off each short's lower 90 % end, so that a short whose presence r
 independent simulator: ψ_m +1.7 % took 0.08 off the three shorts' sum, ../shared/notes/off-twin.md),
 so `widen` raises every short's upper end by β too. On 24 runs drawn within ±2 % (bench_foc.py
 --tolerance 0.02 --case-seed 3307) the shorts' intervals that still missed after the lower ends
-came down all missed above, on actuators with ψ_m up to 2 % high. A result whose three shorts are all within 2β and one of which
-that part alone kept from "present" (`doubts`) is "doubtful": all it found in the windings may be
-the magnet's.
+came down all missed above, on actuators with ψ_m up to 2 % high. A result whose three shorts are
+all within 2β and one of which that part alone kept from "present" (`doubts`) is "doubtful": all
+it found in the windings may be the magnet's.
 """
 
 from __future__ import annotations
@@ -38,14 +38,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...errors import Doubt
-from ...faults import FAULT_NAMES
+from ...faults import FAULT_NAMES, SHORTS
 
 if TYPE_CHECKING:
     from .intervals import Uncertainty
 
-__all__ = ["BAND", "CONSISTENT", "SHORTS", "SLOPE", "allowance", "allowed", "discounted", "doubts", "widen"]
+__all__ = ["BAND", "CONSISTENT", "SLOPE", "allowance", "allowed", "discounted", "doubts", "widen"]
 
-SHORTS = tuple(FAULT_NAMES.index(n) for n in ("short_a", "short_b", "short_c"))
 SLOPE = 1.5  # the balanced short per relative change of ψ_m (the module docstring: 1.25-2 measured)
 BAND = 0.8  # the one-sided 90 % point of a uniform band ±T, in units of T
 CONSISTENT = 0.004  # every short reads at least this when ψ_m is low by 1 % (short B reads least)
@@ -64,21 +63,19 @@ def allowance(params: Any, baseline: bool) -> tuple[float, str]:
     return SLOPE * BAND * t, f"psi_m ±{100 * t:g} % ({f'the tolerances of {path}' if path else 'the default tolerances'})"
 
 
-def _balanced(k_hat: ArrayLike, beta: float) -> np.ndarray | None:
-    """min(k̂_i, β) per short, or None when the shorts are not what a lower ψ_m gives."""
-    shorts = np.asarray(k_hat, dtype=np.float64)[list(SHORTS)]
-    if not beta > 0 or not np.all(shorts >= CONSISTENT):
-        return None
-    return np.minimum(shorts, beta)
+def _parts(K: ArrayLike, beta: float) -> np.ndarray:
+    """min(k̂_i, β) per short of each row of `K` (m, 8), (m, 3); a row's 0 where its shorts are not
+    what a lower ψ_m gives (one below `CONSISTENT`), and all 0 with β = 0."""
+    shorts = np.array(K, dtype=np.float64, ndmin=2)[:, list(SHORTS)]
+    consistent = np.all(shorts >= CONSISTENT, axis=1, keepdims=True)
+    return np.where(consistent & (beta > 0), np.minimum(shorts, beta), 0.0)  # type: ignore[no-any-return]
 
 
 def discounted(k_hat: ArrayLike, beta: float) -> np.ndarray:
     """k̂ with each short's balanced part taken off: what the point rule (`detection.detect`)
     judges without intervals."""
     k = np.array(k_hat, dtype=np.float64, copy=True)
-    part = _balanced(k, beta)
-    if part is not None:
-        k[list(SHORTS)] -= part
+    k[list(SHORTS)] -= _parts(k, beta)[0]
     return k
 
 
@@ -86,16 +83,13 @@ def allowed(
     K: ArrayLike, low: ArrayLike, high: ArrayLike, beta: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The 90 % ends of rows of estimates `K` (m, 8) with the allowance β (the module docstring):
-    (low, high, part), part the balanced part taken off each short's lower end (0 where the row's
-    shorts are not what a lower ψ_m gives). What `widen` and the interval calibration's fit
-    (`factors.fit_factors`) apply alike."""
-    K, lo, hi = (np.array(a, dtype=np.float64, ndmin=2, copy=True) for a in (K, low, high))
+    (low, high, part), part the balanced part taken off each short's lower end (`_parts`). What
+    `widen` and the interval calibration's fit (`factors.fit_factors`) apply alike."""
+    lo, hi = (np.array(a, dtype=np.float64, ndmin=2, copy=True) for a in (low, high))
     rows = list(SHORTS)
-    part = np.zeros((len(K), len(rows)))
+    part = _parts(K, beta)
     if beta > 0:
         hi[:, rows] = np.minimum(hi[:, rows] + beta, 1.0)
-        consistent = np.all(K[:, rows] >= CONSISTENT, axis=1)
-        part[consistent] = np.minimum(K[consistent][:, rows], beta)
         lo[:, rows] = np.maximum(lo[:, rows] - part, 0.0)
     return lo, hi, part
 
@@ -122,9 +116,8 @@ def doubts(
     balanced part alone kept from "present" (`interval`'s lower end before `widen` beyond its
     detection threshold; without intervals, its estimate: the point rule's), for `thresholds`
     (None: the shipped ones). Else nothing found rests on it, and the result is not doubted."""
-    part = _balanced(k_hat, beta)
     shorts = np.asarray(k_hat, dtype=np.float64)[list(SHORTS)]
-    if part is None or not np.all(shorts <= 2.0 * beta):
+    if not np.any(_parts(k_hat, beta) > 0) or not np.all(shorts <= 2.0 * beta):
         return []
     if thresholds is None:
         from ..detection import load_thresholds
