@@ -107,11 +107,42 @@ def test_a_folder_without_the_nameplate_starts_uniform(folder, tmp_path):
     r = emaphm.identify(true_faults=emaphm.HEALTHY, baseline=old, **quick)
     assert r.settings["stages"][0]["start"] == "random" and r.settings["identify"]["start"] == "random"
     assert r.settings["baseline"]["table_from"] is None
+    assert "holds neither" in r.settings["baseline"]["table_skipped"]
     # a nameplate calibration that is not the nameplate's (another actuator's): the same, no refusal
     shutil.copy(folder / FILES["calibration"], old / NAMEPLATE_FILES["calibration"])
     shutil.copy(folder / NAMEPLATE_FILES["params"], old / NAMEPLATE_FILES["params"])
     r = emaphm.identify(true_faults=emaphm.HEALTHY, baseline=old, **quick)
     assert r.settings["stages"][0]["start"] == "random" and r.settings["baseline"]["table_from"] is None
+    assert r.settings["baseline"]["table_skipped"].startswith("the nameplate's files do not load as a monitor")
+    assert based_skip(folder) is None
+
+
+def based_skip(folder):
+    """What a baseline folder's record says of its nameplate's start table (None: it is used)."""
+    from emaphm.baseline import baseline_inputs
+
+    return baseline_inputs(folder)["table_skipped"]
+
+
+def test_a_broken_nameplate_pair_is_said_not_silent(folder, tmp_path, capsys):
+    # one file without its pair, or a calibration that is not JSON: uniform, and the reason named,
+    # in the result's record and as one note line from the command
+    broken = tmp_path / "broken"
+    shutil.copytree(folder, broken)
+    (broken / NAMEPLATE_FILES["calibration"]).unlink()
+    assert based_skip(broken) == f"the folder holds {NAMEPLATE_FILES['params']} without its pair"
+    (broken / NAMEPLATE_FILES["calibration"]).write_text("{not json")
+    assert "do not load as a monitor" in based_skip(broken)
+    out = tmp_path / "r.json"
+    code, _, err = run_cli(
+        ["identify", "--true-faults", "0,0,0,0,0,0,0,0", "--baseline", str(broken), "--seed", "1", "--pop-size", "8",
+         "--generations", "2", "--no-polish", "--last-stage", "none", "--uncertainty", "none", "--output", str(out)],
+        capsys,
+    )  # fmt: skip
+    assert code in (0, 3, 4)
+    notes = [line for line in err.splitlines() if line.startswith("emaphm: note:")]
+    assert len(notes) == 1 and "starts uniform" in notes[0] and "do not load as a monitor" in notes[0], err
+    assert json.loads(out.read_text())["settings"]["baseline"]["table_skipped"] is not None
 
 
 def test_recordings_of_two_actuators_are_refused_with_the_reason(healthy, tmp_path):

@@ -82,7 +82,7 @@ def baseline_inputs(directory: str | os.PathLike[str], **given: Any) -> dict[str
     """What `identify` takes from a baseline folder: params, calibration, uq_calibration (paths),
     thresholds (the detection file's), ``record`` (which baseline, for the result) and the
     nameplate's monitor whose start table the search starts from with its files (``table_monitor``,
-    ``table_from``; None in a folder without them). `given`:
+    ``table_from``; None in a folder without them, and ``table_skipped`` says why). `given`:
     those the caller passed too, each refused (the baseline gives them)."""
     clash = [name for name, value in given.items() if value is not None]
     if clash:
@@ -108,20 +108,28 @@ def baseline_inputs(directory: str | os.PathLike[str], **given: Any) -> dict[str
 
 def _nameplate(directory: Path) -> dict[str, Any]:
     """{"table_monitor": the nameplate's monitor, whose start table the search starts from,
-    "table_from": its files}; both None when they are not in the folder or are not a calibration of
-    that nameplate (a start only: the search then starts uniform)."""
+    "table_from": its files, "table_skipped": None}; the first two None when they are not in the
+    folder or are not a calibration of that nameplate (a start only: the search then starts
+    uniform), and "table_skipped" then says why in one line, for the result's record."""
     from ..actuator import load_params
     from ..models import MonitorEma
 
     paths = {role: directory / name for role, name in NAMEPLATE_FILES.items()}
-    none = {"table_monitor": None, "table_from": None}
-    if not all(p.is_file() for p in paths.values()):
-        return none
+    present = [p.name for p in paths.values() if p.is_file()]
+    if len(present) < len(paths):
+        why = (
+            "the folder holds neither " + " nor ".join(NAMEPLATE_FILES.values())
+            + " (made before them, or from another actuator's calibration)"
+            if not present
+            else f"the folder holds {present[0]} without its pair"
+        )
+        return {"table_monitor": None, "table_from": None, "table_skipped": why}
     try:
         monitor = MonitorEma(load_params(paths["params"]), calibration=paths["calibration"])
-    except InputError:
-        return none
-    return {"table_monitor": monitor, "table_from": {role: str(p) for role, p in paths.items()}}
+    except InputError as exc:
+        return {"table_monitor": None, "table_from": None,
+                "table_skipped": f"the nameplate's files do not load as a monitor ({exc})"}  # fmt: skip
+    return {"table_monitor": monitor, "table_from": {role: str(p) for role, p in paths.items()}, "table_skipped": None}
 
 
 def write_baseline(

@@ -110,6 +110,9 @@ def identify(
         given = {"--params": params, "--calibration": calibration, "--uq-calibration": uq_calibration,
                  "--detection": detection}  # fmt: skip
         files = baseline_inputs(baseline, **given)
+        if files["table_skipped"] is not None:  # slower, not less right: a note, not a warning
+            err.print(f"emaphm: note: the search starts uniform, not from the nameplate's start table: "
+                      f"{files['table_skipped']}", soft_wrap=True)  # fmt: skip
     truth, thresholds = _checked_inputs(
         true_faults=true_faults, reference=reference, map_file=map_file, uncertainty=settings.uncertainty,
         uq_calibration=uq_calibration, output=output, report=report, calibration=calibration, params=params,
