@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -21,6 +21,7 @@ import numpy as np
 
 from ..actuator import resolve_params
 from ..calibration import Calibration
+from ..callbacks import Progress
 from ..errors import InputError
 from ..identification.context import prepare
 from ..identification.recording import measurement
@@ -38,8 +39,6 @@ DISAGREE_SIGMAS = 4.0
 WORSE_FIT = 2.5
 # the noise seeds of the nameplate twin's healthy runs the fit is measured against (`fit.relative`)
 TWIN_SEED = 33_000
-
-Progress = Callable[[str, int, int], None]
 
 
 class Baseline:
@@ -109,7 +108,9 @@ def make_baseline(
         "fit": fit.details,
         "wall_time_s": round(time.perf_counter() - start, 2),
     }  # fmt: skip
-    return Baseline(fitted, cal, fit, record, nameplate, contexts, currents, None if warm else monitor.calibration)
+    return Baseline(
+        fitted, cal, fit, record, nameplate, contexts, currents, None if warm else monitor.calibration
+    )
 
 
 def _monitor(nameplate: Any, calibration: Any) -> tuple[MonitorEma, str | None]:

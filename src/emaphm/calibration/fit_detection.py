@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from .._version import __version__
 from .._versions import versions
 from ..actuator import resolve_params
+from ..callbacks import Progress
 from ..errors import InputError
 from ..faults import FAULT_NAMES, HEALTHY
 from ..identification.api import identify
@@ -61,7 +62,6 @@ DETECTION_RUNS = 20  # healthy runs in each set
 THRESHOLD_SEED, FALSE_ALARM_SEED, SENSITIVITY_SEED = 1000, 2000, 3000
 DETECTION_RULE = "1.25 x the largest healthy departure + 0.005 (k1..k6 from 0, k8 from 0.5)"
 
-Progress = Callable[[str, int, int], None]  # (stage, done, total)
 Identify = Callable[..., Any]  # identify() with every setting but the faults and the seed bound
 
 

@@ -20,14 +20,14 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from .._versions import versions
-from ..choices import STARTS
 from ..actuator import resolve_params
+from ..callbacks import Progress
+from ..choices import STARTS
 from ..errors import InputError
 from ..faults import random_faults
 from ..identification.uncertainty import FIT_COVERAGE, Factors, fit_factors
@@ -47,8 +47,6 @@ UQ_ABSENT = 1.0 / 3.0  # the probability that each fault of a case is absent
 # goes unstable with two phases shorted by more than about 45 % (docs/theory/hf-model.md §4b), which
 # the monitor does not model; more than this means the monitor does not explain the actuator
 MAX_SKIPPED = 0.1
-
-Progress = Callable[[str, int, int], None]
 
 
 def collect_cases(

@@ -9,12 +9,13 @@ on `CHECK_SCENARIOS`; the paper's monitor on `PAPER_FIT_SCENARIOS` / `PAPER_CHEC
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..callbacks import Progress
 from ..commands import Chirp, ChirpHold, Command, Steps
 from ..faults import HEALTHY, as_fault_vector, random_faults
 from ..identification.signals import Comparison
@@ -146,8 +147,6 @@ CHECK_SCENARIOS: tuple[Scenario, ...] = (
     + _random(3, 3203, "chirp-hold")
     + _random(3, 3204, "steps")
 )
-
-Progress = Callable[[str, int, int], None]  # (stage, done, total)
 
 
 def hf_references(

@@ -14,6 +14,8 @@ from typing import Any
 
 from rich.console import Console
 
+from ..callbacks import Progress
+
 __all__ = ["bracketed", "campaign_progress", "err", "logged", "progress", "status", "stdout_console"]
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
@@ -30,7 +32,7 @@ def stdout_console() -> Console:
 
 
 @contextmanager
-def progress() -> Iterator[Callable[[str, int, int], None]]:
+def progress() -> Iterator[Progress]:
     """A progress bar on an interactive terminal (one task per stage); a no-op otherwise."""
     if not err.is_terminal:
         yield lambda stage, done, total: None
@@ -52,7 +54,7 @@ def progress() -> Iterator[Callable[[str, int, int], None]]:
         yield update
 
 
-def bracketed(update: Callable[[str, int, int], None]) -> Callable[[str, int, int], None]:
+def bracketed(update: Progress) -> Progress:
     """`update` (a `progress` bar's) that also prints a line when a stage starts and one when it
     ends, when stderr is a log, not a terminal: work that is not a generation and may take seconds
     (a start table's build), which a log would otherwise pass over in silence."""
@@ -71,7 +73,7 @@ def bracketed(update: Callable[[str, int, int], None]) -> Callable[[str, int, in
     return report
 
 
-def logged(update: Callable[[str, int, int], None]) -> Callable[[str, int, int], None]:
+def logged(update: Progress) -> Progress:
     """`update` (a `progress` bar's) that also prints a line every 10 steps when stderr is a log,
     not a terminal (the long calibrations)."""
 

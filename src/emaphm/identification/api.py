@@ -17,6 +17,7 @@ from .._threads import numba_threads
 from .._versions import versions
 from ..actuator import resolve_params
 from ..calibration import Calibration, params_hash
+from ..callbacks import Progress
 from ..commands import Chirp
 from ..errors import Doubt, InputError
 from ..models import MonitorEma
@@ -27,7 +28,7 @@ from .baseline_inputs import divided_by_gain, with_baseline
 from .coverage import command_rate
 from .identifier import FaultIdentifier
 from .last_stage import SwitchingModel, resolve_last_stage
-from .optimizers import OnGeneration, Progress
+from .optimizers import OnGeneration
 from .preconditions import estimate_doubts
 from .recording import Measurement, measurement, split_seed
 from .result import IdentificationResult

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..callbacks import Progress
 from ..commands import Command
 from ..errors import InputError, SimulationError
 from ..kernels.monitor import RING_OUTER
@@ -21,7 +22,7 @@ from ..models import MonitorEma
 from ..results import check_time_axis
 from . import limits
 from .fitness import Fitness
-from .optimizers import OnGeneration, Progress
+from .optimizers import OnGeneration
 from .problem import search_to_faults
 from .settings import IdentifySettings
 from .signals import Comparison, nrmse

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..callbacks import Progress
 from ..commands import Command
 from ..errors import InputError
 from ..faults import as_fault_vector
@@ -27,7 +28,7 @@ from ..models import MonitorEma
 from . import search
 from .context import Context, prepare
 from .last_stage import last_stage
-from .optimizers import OnGeneration, Progress
+from .optimizers import OnGeneration
 from .problem import search_to_faults
 from .second_search import second_search
 from .settings import IdentifySettings

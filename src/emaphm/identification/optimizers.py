@@ -54,7 +54,6 @@ Objective = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 # a batch of residual vectors: X (m, n) -> R (m, p), with the objective Σ_j R[i, j]² per row
 Residuals = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 OnGeneration = Callable[[int, int, float], None]  # (generation, max generations, best value)
-Progress = Callable[[str, int, int], None]  # other long work: (what, done, total), the start table's build
 
 
 @dataclass(frozen=True)

@@ -43,10 +43,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from ..callbacks import Progress
 from ..errors import InputError
 from ..kernels.fitness import residuals_lf_many
 from .multistart import latin_hypercube
-from .optimizers import Progress
 from .problem import search_to_faults
 
 if TYPE_CHECKING:
