@@ -116,19 +116,19 @@ def _nameplate(directory: Path) -> dict[str, Any]:
 
     paths = {role: directory / name for role, name in NAMEPLATE_FILES.items()}
     present = [p.name for p in paths.values() if p.is_file()]
-    if len(present) < len(paths):
-        why = (
-            "the folder holds neither " + " nor ".join(NAMEPLATE_FILES.values())
-            + " (made before them, or from another actuator's calibration)"
-            if not present
-            else f"the folder holds {present[0]} without its pair"
-        )
+
+    def skipped(why: str) -> dict[str, Any]:
         return {"table_monitor": None, "table_from": None, "table_skipped": why}
+
+    if not present:
+        return skipped(f"the folder holds neither {' nor '.join(NAMEPLATE_FILES.values())} (made before them, "
+                       "or from another actuator's calibration)")  # fmt: skip
+    if len(present) < len(paths):
+        return skipped(f"the folder holds {present[0]} without its pair")
     try:
         monitor = MonitorEma(load_params(paths["params"]), calibration=paths["calibration"])
     except InputError as exc:
-        return {"table_monitor": None, "table_from": None,
-                "table_skipped": f"the nameplate's files do not load as a monitor ({exc})"}  # fmt: skip
+        return skipped(f"the nameplate's files do not load as a monitor ({exc})")
     return {"table_monitor": monitor, "table_from": {role: str(p) for role, p in paths.items()}, "table_skipped": None}
 
 

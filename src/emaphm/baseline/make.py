@@ -108,9 +108,7 @@ def make_baseline(
         "fit": fit.details,
         "wall_time_s": round(time.perf_counter() - start, 2),
     }  # fmt: skip
-    return Baseline(
-        fitted, cal, fit, record, nameplate, contexts, currents, None if warm else monitor.calibration
-    )
+    return Baseline(fitted, cal, fit, record, nameplate, contexts, currents, None if warm else monitor.calibration)
 
 
 def _monitor(nameplate: Any, calibration: Any) -> tuple[MonitorEma, str | None]:

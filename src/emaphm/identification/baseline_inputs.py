@@ -18,8 +18,9 @@ def with_baseline(
     baseline: Any, s: IdentifySettings, params: Any, calibration: Any, uq_calibration: Any, thresholds: Any
 ) -> tuple[Any, ...]:
     """The settings and the inputs a baseline folder gives (`baseline.baseline_inputs`), its
-    record (with ``table_from``, the nameplate's files, or ``table_skipped``, why not) and the nameplate's monitor whose start
-    table the search starts from; as given without one (and no monitor). A folder without the
+    record (with ``table_from``, the nameplate's files, or ``table_skipped``, why not) and the
+    nameplate's monitor whose start table the search starts from; as given without one (and no
+    monitor). A folder without the
     nameplate's files (made before them, or from another actuator's calibration) makes the start
     "auto" uniform: one actuator's own table would serve few diagnoses for its 9 s build
     (docs/identification.md §3)."""
