@@ -44,3 +44,54 @@ def test_too_many_workers_is_refused_in_one_line():
     with pytest.raises(InputError, match=r"--workers must be 0\.\."):
         with numba_threads(10_000, name="--workers"):
             pass
+
+
+def _fresh(code: str) -> list[str]:
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return out.stdout.split()
+
+
+def test_a_blas_loaded_inside_the_block_gets_one_thread_only_when_said():
+    # a fresh process: scipy's own BLAS is not loaded until scipy.optimize is imported
+    code = (
+        "import sys; from threadpoolctl import threadpool_info as info, threadpool_limits\n"
+        "from emaphm._threads import numba_threads, blas_loaded\n"
+        "scipys = lambda: sorted(p['num_threads'] for p in info() if 'scipy_openblas-' in p['filepath'])\n"
+        "with threadpool_limits(limits=2, user_api='blas'):\n"
+        "    assert 'scipy.linalg' not in sys.modules\n"
+        "    with numba_threads(1):\n"
+        "        import scipy.optimize\n"
+        "        print(scipys())\n"  # loaded inside the block: the block's limit did not reach it
+        "        blas_loaded(); print(scipys())\n"
+        "    print(scipys())\n"  # restored with the block
+        "blas_loaded(); print(scipys())\n"  # outside a block: nothing
+    )
+    before, said, after, outside = _fresh(code)
+    assert said == "[1]" and before != "[1]"
+    assert after == outside == before
+
+
+def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
+    # kernels/_jit.QuickLoadCache: a cached kernel loads without importing numba's lowering
+    # registries (numba.np.linalg is one); a compilation afterwards still works (it refreshes)
+    code = (
+        "import sys, numpy as np\n"
+        "from emaphm.identification.api import identify\n"
+        "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4,\n"
+        "         polish=False, last_stage='none', uncertainty='none')\n"
+        "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4,\n"
+        "         polish=False, last_stage='none', uncertainty='none')\n"
+        "print('numba.np.linalg' in sys.modules, [m for m in ('scipy.ndimage', 'scipy.spatial', 'scipy.optimize') if m in sys.modules])\n"
+        "from emaphm.kernels.fitness import fitness_lf_many\n"
+        "print(sum(fitness_lf_many.stats.cache_hits.values()) > 0, sum(fitness_lf_many.stats.cache_misses.values()))\n"
+        "import numba\n"
+        "print(numba.njit(lambda a: np.linalg.det(a))(np.eye(3)))\n"
+    )
+    _fresh(code)  # a cold cache compiles here (a fresh machine): the second process loads
+    out = _fresh(code)
+    assert out[0] == "False" and out[1] == "[]", out
+    assert out[2:4] == ["True", "0"], out  # loaded from the cache, not compiled
+    assert out[4] == "1.0"

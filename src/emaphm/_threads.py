@@ -6,8 +6,10 @@ eigendecomposition) and keeps spinning while numba's pool runs the next kernel: 
 two pools fight, and the least-squares polish took 0.56 s instead of 0.07 s (Table 1 case, the
 same numbers). The matrices here are small (8 columns), so one BLAS thread loses nothing.
 `threadpoolctl` sets and restores the limit; it reaches the BLAS libraries loaded when a
-block is entered (numpy's, and scipy's, which `emaphm.identification` loads through
-`scipy.optimize`). The limit is the process's, and threadpoolctl lets one thread at a time
+block is entered (numpy's), and those a module imported inside the block loads, where that
+import is followed by `blas_loaded` (scipy's, which the polish loads through `scipy.optimize`:
+nothing else on a diagnosis's path imports scipy before it, issue 36; without the call, the
+Table 1 case took 0.5 s more wall and 1 s more CPU). The limit is the process's, and threadpoolctl lets one thread at a time
 control it (the others' calls do nothing): where several threads run blocks at once, those
 other than the first may run beside BLAS's own pool, slower.
 """
@@ -15,6 +17,7 @@ other than the first may run beside BLAS's own pool, slower.
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
@@ -23,6 +26,8 @@ from .errors import InputError
 
 T = TypeVar("T")
 R = TypeVar("R")
+
+_OPEN = threading.local()  # .blocks: this thread's open numba_threads blocks, innermost last
 
 
 @contextlib.contextmanager
@@ -37,11 +42,28 @@ def numba_threads(workers: int | None, *, name: str = "workers") -> Iterator[Non
         raise InputError(f"{name} must be 0..{available}, got {workers}")
     previous = numba.get_num_threads()
     numba.set_num_threads(workers or available)
+    blocks: list[contextlib.ExitStack] = _OPEN.__dict__.setdefault("blocks", [])
     try:
-        with threadpool_limits(limits=1, user_api="blas"):
-            yield
+        with contextlib.ExitStack() as block:
+            block.enter_context(threadpool_limits(limits=1, user_api="blas"))
+            blocks.append(block)
+            try:
+                yield
+            finally:
+                blocks.pop()
     finally:
         numba.set_num_threads(previous)
+
+
+def blas_loaded() -> None:
+    """Inside a `numba_threads` block, give the BLAS libraries loaded since it was entered the
+    block's one thread too, until it ends (outside a block: nothing). Call it after an import
+    inside the block that may load one (module docstring)."""
+    blocks = getattr(_OPEN, "blocks", None)
+    if blocks:
+        from threadpoolctl import threadpool_limits
+
+        blocks[-1].enter_context(threadpool_limits(limits=1, user_api="blas"))
 
 
 def thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:

@@ -146,7 +146,7 @@ def test_an_identification_imports_neither_scipy_signal_nor_matplotlib_nor_scipy
         "r = identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=2, pop_size=8)\n"
         "assert r.uncertainty is not None and r.stage('least_squares')['ran']\n"
         "assert r.stage('polish')['ran'] and r.stage('last_stage')['switching'] is not None\n"
-        "print([m for m in ('scipy.signal', 'matplotlib', 'scipy.stats') if m in sys.modules])\n"
+        "print([m for m in ('scipy.signal', 'scipy.ndimage', 'matplotlib', 'scipy.stats') if m in sys.modules])\n"
         "import matplotlib.pyplot, scipy.stats\n"  # and both are importable afterwards
         "print(matplotlib.pyplot.__name__, scipy.stats.norm.cdf(0.0))\n"
     )

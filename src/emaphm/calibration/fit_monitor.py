@@ -29,7 +29,7 @@ from .._version import __version__
 from .._versions import versions
 from ..commands import Command, command_record
 from ..errors import InputError
-from ..identification.optimizers import BatchProblem, minimize_batch
+from ..identification.optimizers import BatchProblem, NumpyDuplicates, minimize_batch
 from ..identification.signals import CUTOFF_HZ, FILTER_ORDER, Comparison
 from ..models._base import check_seed
 from ..params import EmaParams
@@ -236,13 +236,13 @@ def _search(
     # the mean NRMSE over the fitting scenarios as a function of the coefficient vector
     lo, hi = zip(*(task.bounds[n] for n in task.fitted), strict=True)
     problem = BatchProblem(objective, lo, hi)
-    algorithm = GA(pop_size=task.pop_size)
+    algorithm = GA(pop_size=task.pop_size, eliminate_duplicates=NumpyDuplicates())
     if task.subset:
         # a subset fit starts from where it is: the start's values are one of the first population
         # (uniform in the box otherwise, from the seed), so the GA's elitism never ends it worse
         X0 = np.random.default_rng(task.seed).uniform(lo, hi, size=(task.pop_size, len(task.fitted)))
         X0[0] = np.clip([getattr(task.initial, n) for n in task.fitted], lo, hi)
-        algorithm = GA(pop_size=task.pop_size, sampling=X0)
+        algorithm = GA(pop_size=task.pop_size, sampling=X0, eliminate_duplicates=NumpyDuplicates())
     # a fixed number of generations: no early stop
     x, _, history = minimize_batch(
         problem, algorithm, task.generations, seed=task.seed, on_generation=on_generation

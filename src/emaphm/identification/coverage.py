@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..calibration import Calibration
 from ..commands import Command
+from .windows import running_max
 
 __all__ = ["COMMAND_TOLERANCE", "command_rate", "command_warnings", "matches"]
 
@@ -46,12 +47,10 @@ def matches(
         peak = float(np.max(np.abs(expected)))
         allowed = np.full(len(expected), COMMAND_TOLERANCE * peak)
         if h > step and len(expected) > 2:
-            from scipy.ndimage import maximum_filter1d  # 0.2-0.5 s to import: only when needed
-
             curvature = np.zeros(len(expected))
             curvature[1:-1] = np.abs(np.diff(expected, 2)) / step**2
-            window = 2 * math.ceil(h / step) + 1
-            allowed += h * h / 8.0 * maximum_filter1d(curvature, window, mode="nearest")
+            reach = math.ceil(h / step)  # the centred window of 2 * reach + 1 samples
+            allowed += h * h / 8.0 * running_max(curvature, reach, reach, mode="nearest")
         deviation = np.abs(theta[inside] - expected)
         if np.all(deviation <= allowed) or (peak == 0.0 and not deviation.any()):
             return True

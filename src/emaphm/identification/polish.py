@@ -13,9 +13,12 @@ does nothing.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 from numpy.typing import NDArray
 
+from .._threads import blas_loaded
 from . import limits
 from .cmaes import cmaes
 from .context import Context
@@ -120,8 +123,11 @@ def least_squares_polish(
     diverges is rejected; a Jacobian probe that diverges spoils its column, and the step it
     proposes then rarely fits better, so the start is kept. The history continues the start's.
     """
+    fresh = "scipy.optimize" not in sys.modules
     from scipy.optimize import least_squares
 
+    if fresh:  # scipy's BLAS has just loaded, inside the caller's numba_threads block
+        blas_loaded()
     step = limits.LS_STEP if step is None else step
     max_nfev = limits.LS_MAX_NFEV if max_nfev is None else max_nfev
 

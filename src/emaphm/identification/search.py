@@ -20,6 +20,7 @@ from .gwo import grey_wolf
 from .multistart import multistart
 from .optimizers import (
     BatchProblem,
+    NumpyDuplicates,
     Objective,
     OnGeneration,
     OptimizerRun,
@@ -92,9 +93,9 @@ def _pymoo_algorithm(
         from pymoo.algorithms.soo.nonconvex.ga import GA
         from pymoo.operators.crossover.pcx import PCX
 
-        if initial is not None:  # pymoo takes an array as the first population
-            return GA(pop_size=pop_size, sampling=np.array(initial), crossover=PCX(eta=0.5, zeta=0.5))
-        return GA(pop_size=pop_size, crossover=PCX(eta=0.5, zeta=0.5))
+        sampling = {} if initial is None else {"sampling": np.array(initial)}  # an array: the first population
+        return GA(pop_size=pop_size, crossover=PCX(eta=0.5, zeta=0.5), eliminate_duplicates=NumpyDuplicates(),
+                  **sampling)  # fmt: skip
     if name == "de":
         from pymoo.algorithms.soo.nonconvex.de import DE
 

@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.ndimage import maximum_filter1d
 
 from ..errors import InputError
 from .limits import (
@@ -29,6 +28,7 @@ from .limits import (
     REVERSAL_FRACTION,
 )
 from .settings import parse_error_corner
+from .windows import running_max, running_min
 
 __all__ = [
     "BAND_HZ",
@@ -55,10 +55,7 @@ __all__ = [
 
 def _trailing_spread(pos: NDArray[np.float64], window: int) -> NDArray[np.float64]:
     """max − min of `pos` over the `window` + 1 samples ending at each sample (running max and min)."""
-    from scipy.ndimage import maximum_filter1d, minimum_filter1d
-
-    origin = window // 2  # trailing: the window ends at the sample
-    return maximum_filter1d(pos, window + 1, origin=origin) - minimum_filter1d(pos, window + 1, origin=origin)  # type: ignore[no-any-return]
+    return running_max(pos, window, mode="reflect") - running_min(pos, window, mode="reflect")
 
 
 def moving_mask(
@@ -209,7 +206,7 @@ def error_weights(
     f = command_frequency(theta, f_s)
     memory = round(ERROR_MEMORY_S * f_s)
     if memory > 0 and len(f):  # the highest over [t - memory, t]: a trailing maximum
-        f = maximum_filter1d(f, size=memory + 1, origin=memory // 2, mode="nearest")
+        f = running_max(f, memory, mode="nearest")
     return 1.0 / (1.0 + (f / corner_hz) ** 2)  # type: ignore[no-any-return]
 
 

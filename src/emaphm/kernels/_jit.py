@@ -12,6 +12,14 @@ The cache lives in ``$NUMBA_CACHE_DIR/emaphm-kernels-<hash>/<package>`` when the
 renamed copy of the package must not read this one's entries). When
 no such folder can be written, the kernels compile in memory on every run (slower start, never
 stale).
+
+Loading a cached kernel: numba's `Cache.load_overload` first refreshes the whole target context,
+importing every lowering registry numba has (linalg, random, typed containers, ...: about 0.4 s
+of a diagnosis's start, issue 36), which only *compiling* needs; loading machine code needs the
+runtime (NRT) initialised. emaphm's kernels therefore load through `QuickLoadCache`, which
+initialises the runtime and nothing else; a compilation still refreshes the context itself
+(numba's `CompilerBase.__init__`), so a cache miss, or any other jitted function, compiles as
+before. Where numba's cache lacks the two methods it builds on, the kernels keep numba's own.
 """
 
 from __future__ import annotations
@@ -25,6 +33,7 @@ from typing import Any, TypeVar
 
 from numba import config, njit
 from numba.core import caching
+from numba.core.runtime import rtsys
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -98,6 +107,27 @@ if KernelCacheLocator not in _CACHE_IMPL._locator_classes:
 CACHE_ENABLED = _writable(kernel_cache_dir() / __name__.split(".", 1)[0])
 
 
+class QuickLoadCache(caching.FunctionCache):  # type: ignore[misc]
+    """numba's function cache, loading without the target context's refresh (module docstring)."""
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        rtsys.initialize(target_context)  # what loaded machine code needs of the context
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+
+QUICK_LOAD = all(
+    hasattr(caching.FunctionCache, name)
+    for name in ("_load_overload", "_guard_against_spurious_io_errors")
+)
+
+
+def _quick_load(dispatcher: Any) -> Any:
+    if CACHE_ENABLED and QUICK_LOAD and getattr(dispatcher, "_cache", None) is not None:
+        dispatcher._cache = QuickLoadCache(dispatcher.py_func)
+    return dispatcher
+
+
 def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False) -> Any:
     """``numba.njit`` with the project's settings; with `nogil` the compiled function releases
     the GIL, so Python threads run it side by side (`HighFidelityEma.simulate_batch`).
@@ -108,4 +138,8 @@ def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False) -> 
     ``fastmath`` stays off so results are bit-reproducible.
     """
     decorator = njit(cache=CACHE_ENABLED, parallel=parallel, nogil=nogil, error_model="numpy")
-    return decorator if fn is None else decorator(fn)
+
+    def cached(f: F) -> Any:
+        return _quick_load(decorator(f))
+
+    return cached if fn is None else cached(fn)
