@@ -82,8 +82,6 @@ def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
         "from emaphm.identification.api import identify\n"
         "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4,\n"
         "         polish=False, last_stage='none', uncertainty='none')\n"
-        "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4,\n"
-        "         polish=False, last_stage='none', uncertainty='none')\n"
         "print('numba.np.linalg' in sys.modules, [m for m in ('scipy.ndimage', 'scipy.spatial', 'scipy.optimize') if m in sys.modules])\n"
         "from emaphm.kernels.fitness import fitness_lf_many\n"
         "print(sum(fitness_lf_many.stats.cache_hits.values()) > 0, sum(fitness_lf_many.stats.cache_misses.values()))\n"

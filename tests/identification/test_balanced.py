@@ -105,8 +105,9 @@ def test_a_weaker_magnet_is_not_reported_as_three_shorts():
     thresholds = load_thresholds()["thresholds"]
     present_before = any(lo > thresholds[FAULT_NAMES[i]] for i, lo in zip(SHORTS, allowance["low_before"], strict=True))
     said = any("every phase reads a small short" in d for d in r.doubts)
-    assert said == present_before
-    assert r.verdict == ("doubtful" if said else r.verdict) and r.verdict != "does not fit"
+    assert said == present_before and r.verdict != "does not fit"
+    if said:
+        assert r.verdict == "doubtful"
     # the same recording with no flux tolerance: the shorts are what the monitor found
     assert doubts(r.estimate, 0.0, "s", None, r.uncertainty) == []
 
