@@ -97,10 +97,10 @@ def main(argv: list[str] | None = None) -> None:
     monitor = emaphm.MonitorEma(params, command, args.calibration, monitor=args.monitor)
     hf = emaphm.HighFidelityEma(params, command)
     errs, walls, wrong, bias_runs, nrmses, nrmses_cmp = [], [], 0, 0, [], []
-    fits, second_runs, second_taken = [], 0, 0
+    fits, second_runs, second_taken, evaluations = [], 0, 0, []
     switching, nrmses_switching, stage_taken = SwitchingModel(params, command), [], 0
     print(
-        f"{'case':>4} {'NRMSE':>6} {'cmp':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'fit':>6} {'wall':>5}  shorts"
+        f"{'case':>4} {'NRMSE':>6} {'cmp':>6} {'seed':>4} {'%err':>6} {'f_run':>8} {'f_best':>8} {'f_true':>8} {'fit':>6} {'wall':>5} {'evals':>5}  shorts"
     )
     for j, k in enumerate(cases):
         clean = hf.simulate(k, noise=False)
@@ -124,6 +124,7 @@ def main(argv: list[str] | None = None) -> None:
                 reference=trace, seed=s, params=params, calibration=monitor.calibration, **settings_of(args, SETTINGS)
             )
             walls.append(time.perf_counter() - t0)
+            evaluations.append(run.evaluations)
             err = emaphm.percent_error(run.estimate, k)
             errs.append(err)
             others = [
@@ -156,7 +157,7 @@ def main(argv: list[str] | None = None) -> None:
             wrong += is_wrong
             bias_runs += f_true > f_run
             print(f"{j:>4} {100 * nrmse:>5.2f}% {100 * nrmses_cmp[-1]:>5.2f}% {s:>4} {err:>6.2f} {f_run:>8.4f} {f_best:>8.4f} {f_true:>8.4f} "
-                  f"{100 * run.fit_nrmse:>5.2f}% {walls[-1]:>5.1f}  {k[2]:.2f} {k[3]:.2f} {k[4]:.2f}" + ("  WRONG BASIN" if is_wrong else "") + mark,
+                  f"{100 * run.fit_nrmse:>5.2f}% {walls[-1]:>5.1f} {run.evaluations:>5}  {k[2]:.2f} {k[3]:.2f} {k[4]:.2f}" + ("  WRONG BASIN" if is_wrong else "") + mark,
                   flush=True)  # fmt: skip
     n = len(errs)
     print()
@@ -170,6 +171,7 @@ def main(argv: list[str] | None = None) -> None:
           f"second searches (fit above {100 * SECOND_SEARCH_NRMSE[monitor.monitor]:g} %): {second_runs} of {n}, taken {second_taken}")  # fmt: skip
     print(f"switching last stage ({args.last_stage}) moved the estimate in {stage_taken} of {n} runs")
     print(f"wall time per identification: median {statistics.median(walls):.1f} s, max {max(walls):.1f} s")
+    print(f"monitor evaluations per identification: {spread(evaluations, digits=0)}")
 
 
 if __name__ == "__main__":

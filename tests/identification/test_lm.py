@@ -47,7 +47,8 @@ def test_a_minimum_outside_the_box_ends_on_its_bound_as_scipys():
     assert np.all((res.x >= 0.0) & (res.x <= 1.0))
 
 
-def test_never_worse_than_its_start_and_keeps_to_the_budget():
+@pytest.mark.parametrize(("broyden", "budget"), [(False, 3), (True, 3), (True, 7)])
+def test_never_worse_than_its_start_and_keeps_to_the_budget(broyden, budget):
     calls = []
 
     def counted(X):
@@ -56,8 +57,8 @@ def test_never_worse_than_its_start_and_keeps_to_the_budget():
 
     x0 = np.array([0.1, 0.9, 0.2])
     f0 = float(np.sum(_decay(x0) ** 2))
-    res = _solve(counted, x0, step=1e-4, max_nfev=3)
-    assert res.nfev <= 3 and res.status == "budget"
+    res = _solve(counted, x0, step=1e-4, max_nfev=budget, broyden=broyden)
+    assert res.nfev <= budget and res.status == "budget"
     assert res.f <= f0 * (1.0 + 1e-12)
     # the trial points counted by nfev, the Jacobians in batches of n rows by njev (and the start)
     assert sum(calls) == 1 + res.nfev + 3 * res.njev
@@ -98,3 +99,36 @@ def test_descents_in_lockstep_take_each_the_path_it_takes_alone():
         assert (a.f, a.nfev, a.njev, a.status) == (b.f, b.nfev, b.njev, b.status)
     assert {a.status for a in together} <= {"ftol", "xtol", "budget"}
     assert len({a.nfev for a in together}) > 1  # they stopped at different rounds
+
+
+@pytest.mark.parametrize("x0", [(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45)])
+def test_secant_updates_reach_the_same_minimum_with_fewer_jacobians(x0):
+    # Broyden's updates replace most difference Jacobians; the descent still ends at scipy's
+    # minimum (a zero residual here), and on a difference Jacobian, not on a secant one
+    full = _solve(_decay, x0, step=1e-6, max_nfev=200)
+    secant = _solve(_decay, x0, step=1e-6, max_nfev=200, broyden=True)
+    np.testing.assert_allclose(secant.x, [0.7, 0.4, 0.55], atol=1e-5)
+    assert secant.f == pytest.approx(full.f, abs=1e-10)
+    assert secant.njev < full.njev
+    assert secant.njev * 3 + secant.nfev < full.njev * 3 + full.nfev  # fewer residual rows in all
+    assert secant.status in ("ftol", "xtol")
+
+
+def test_secant_descents_in_lockstep_take_each_the_path_it_takes_alone():
+    starts = np.array([(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45)])
+    together = levenberg_marquardt_many(_decay, starts, _decay(starts), step=1e-4, max_nfev=40, broyden=True)
+    for a, x0 in zip(together, starts, strict=True):
+        b = _solve(_decay, x0, step=1e-4, max_nfev=40, broyden=True)
+        np.testing.assert_array_equal(a.x, b.x)
+        assert (a.f, a.nfev, a.njev, a.status) == (b.f, b.nfev, b.njev, b.status)
+
+
+def test_steps_shorter_than_min_secant_leave_the_jacobian_alone():
+    # with every step below min_secant no secant update happens: the path is plain
+    # Levenberg-Marquardt on Jacobians reused between refreshes, never a corrupted one, and the
+    # descent still reaches the minimum (each stop is checked on a fresh difference Jacobian)
+    x0 = (0.2, 0.8, 0.6)
+    res = _solve(_decay, x0, step=1e-6, max_nfev=400, broyden=True, min_secant=10.0)
+    np.testing.assert_allclose(res.x, [0.7, 0.4, 0.55], atol=1e-5)
+    assert res.status in ("ftol", "xtol")
+

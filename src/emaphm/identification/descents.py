@@ -2,8 +2,14 @@
 by `lm_polish_many`) and the multistart search's descents (`multistart`, by `descend_from`).
 
 Each descent is the bounded Levenberg–Marquardt of `lm` on eq. 3's residual vector with the
-polishes' Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`); several run in
+polishes' Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`), its Jacobian updated
+by secants between difference ones (`limits.LS_BROYDEN`, `limits.LS_MIN_SECANT`); several run in
 lockstep, one batch of monitor runs per round (`lm.levenberg_marquardt_many`).
+
+The secants (issue 36, tenth session): a descent from the Table 1 case's runner-ups took 140–150
+monitor runs (11–17 difference Jacobians of 8 rows and 24–30 trial points), with them 80–95 (6–8
+Jacobians), and went as far or further; on 240 paired random twin runs the final %err moved by
+−0.02 ± 0.03 with no wrong basin (BENCHMARKS.md, issue 36).
 """
 
 from __future__ import annotations
@@ -62,7 +68,8 @@ def lm_polish_many(
         try:
             results = levenberg_marquardt_many(
                 lambda X: np.asarray(residuals(X), dtype=np.float64), X0[ok], R0[ok], step=limits.LS_STEP,
-                max_nfev=limits.LS_MAX_NFEV, fill=fill, on_round=on_round,
+                max_nfev=limits.LS_MAX_NFEV, fill=fill, on_round=on_round, broyden=limits.LS_BROYDEN,
+                min_secant=limits.LS_MIN_SECANT,
             )  # fmt: skip
         except (ValueError, np.linalg.LinAlgError):
             results = []

@@ -36,7 +36,9 @@ __all__ = [
     "HOLD_SETTLE_S",
     "LAPLACE_STEPS",
     "LONG_HOLD_S",
+    "LS_BROYDEN",
     "LS_MAX_NFEV",
+    "LS_MIN_SECANT",
     "LS_STEP",
     "MAX_SPAN",
     "MAX_STEPS",
@@ -97,8 +99,7 @@ DEFAULT_BUDGETS: dict[str, tuple[int, int]] = {
     "pso": (64, 60),
     "cmaes": (64, 60),
     "gwo": (64, 60),
-    # (sample, descents): a Latin hypercube of 256 points, least squares from its 8 best distinct
-    # ones, ≈ 1 500 evaluations (`multistart`, issue 36)
+    # (sample, descents): 256 Latin-hypercube points, least squares from the 8 best distinct (`multistart`)
     "multistart": (256, 8),
 }
 # the multistart's descents start from sample points this far apart in some fault (max norm over
@@ -110,20 +111,22 @@ TABLE_GENERATIONS = 15
 # ---- the polish (`polish`) ----
 POLISH_BUDGET = (32, 50)  # population, generations of the CMA-ES polish
 POLISH_PATIENCE = 15  # the CMA-ES polish stops after this many generations without gain
-# the best point's polish (issue 36): "preconditioned" (`preconditioned`: least squares, then a CMA-ES
-# in the Gauss-Newton Hessian's round coordinates, `budget` (population, generations), each axis's step
-# raising the model's f by `scale` f/n, clipped to `steps`) or "round" (a CMA-ES of POLISH_BUDGET)
+# the best point's polish (issue 36): "preconditioned" (`preconditioned`: least squares, then a CMA-ES in
+# the Gauss-Newton Hessian's round coordinates, `budget` (population, generations), stopped after `patience`
+# generations without gain, a step raising the model's f by `scale` f/n, in `steps`) or "round"
 POLISH_ROUTE = "preconditioned"
-PRECONDITIONED: dict[str, Any] = {"budget": (16, 30), "scale": 0.5, "steps": (1e-4, 0.1)}
+PRECONDITIONED: dict[str, Any] = {"budget": (16, 30), "patience": 6, "scale": 0.5, "steps": (1e-4, 0.1)}
 # a population member counts as another candidate when one of its faults differs from the best's
 # by more than this (k7 on the circle); measured on bench_multifault's 40 x 2 cases (docs/identification.md §3)
 RUNNER_UP_DISTANCE = 0.05
 # the points the polish starts from: the search's best and up to four distinct runner-ups
 POLISH_CANDIDATES = 5
-# the least-squares polish: the forward-difference step of its Jacobian in the unit box, and its
-# budget of residual evaluations (each Jacobian costs n more, in one batch)
+# the least-squares polish: its Jacobian's forward-difference step in the unit box, its budget of trial
+# points (each Jacobian costs n more, in one batch); the in-house descents (`descents`) update their
+# Jacobian by secants after steps longer than LS_MIN_SECANT (`lm`; issue 36: a third of their runs)
 LS_STEP = 1e-2
 LS_MAX_NFEV = 30
+LS_BROYDEN, LS_MIN_SECANT = True, 1e-3
 
 # ---- the final checks (`checks`) ----
 # an eccentricity below this is at its bound, where its direction k7 has no effect on the fitness

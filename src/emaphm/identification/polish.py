@@ -195,7 +195,7 @@ def polish_stage(state: State | None, context: Context) -> tuple[State, Record]:
     are least-squares end points (`multistart`).
 
     Until issue 36 the best runner-up got a CMA-ES polish of its own (up to 1569 evaluations);
-    least squares from up to four of them costs 60–130 LF runs each. Least squares does not
+    least squares from up to four of them costs 80–100 LF runs each. Least squares does not
     replace the best point's CMA-ES: where the valley is narrower than its finite-difference step
     it stops short (the interval calibration's case 94, seed 4101: 4.2 x the fitness a CMA-ES then
     reached from its point), and a pipeline started with it moved estimates the calibrations rest

@@ -6,14 +6,16 @@ direction, `polish.polish`) spends most of its runs learning that shape: on the 
 `studies/multistart_cases.py` from the start table's 15 generations it used its whole 32 × 50
 budget every time (1 569 runs). Here the shape is taken from the residuals instead:
 
-1. a least-squares descent from the start (`descents.lm_polish`, 60–130 runs), which goes down
+1. a least-squares descent from the start (`descents.lm_polish`, 40–100 runs with its secant
+   Jacobians), which goes down
    the valley's floor where its finite-difference Jacobian sees it;
 2. the Jacobian J of the residuals at its end (n + 1 runs, `limits.LS_STEP`), so that
    f(x₀ + δ) ≈ f(x₀) + 2 rᵀJδ + δᵀ(JᵀJ)δ; with JᵀJ = V Λ Vᵀ the search runs in y, x = x₀ + V S y,
    S = diag(s_i), s_i = √(c·f(x₀) / (n λ_i)) (a step of one along each axis raises the model's
    f by c·f(x₀)/n), clipped to ``limits.PRECONDITIONED["steps"]`` in the unit box;
-3. a CMA-ES in y from 0 with step 1 (``limits.PRECONDITIONED["budget"]``), a point outside the box
-   clipped to it and charged for the distance, so that the search stays inside.
+3. a CMA-ES in y from 0 with step 1 (``limits.PRECONDITIONED["budget"]``, stopped after
+   ``"patience"`` generations without gain), a point outside the box clipped to it and charged for
+   the distance, so that the search stays inside.
 
 The fitness is rough on scales below ~1e-3 (the monitor's discrete stick and contact events:
 forward differences of 1e-5 and 1e-3 disagree in sign in some faults), which is why the
@@ -119,7 +121,7 @@ def preconditioned_polish(
     problem = BatchProblem(in_y, -bound, bound)
     y, f, history = minimize_batch(
         problem, cmaes(np.zeros(len(x0)), 0.5 / Y_BOUND, pop_size, generations), generations, seed=seed,
-        stagnation=Stagnation(patience=limits.POLISH_PATIENCE), on_generation=on_generation,
+        stagnation=Stagnation(patience=limits.PRECONDITIONED["patience"]), on_generation=on_generation,
     )  # fmt: skip
     evaluations += problem.evaluations
     x = x0 + M @ y
