@@ -7,9 +7,9 @@ two pools fight, and the least-squares polish took 0.56 s instead of 0.07 s (Tab
 same numbers). The matrices here are small (8 columns), so one BLAS thread loses nothing.
 `threadpoolctl` sets and restores the limit; it reaches the BLAS libraries loaded when a
 block is entered (numpy's), and those a module imported inside the block loads, where that
-import is followed by `blas_loaded` (scipy's, which the polish loads through `scipy.optimize`:
-nothing else on a diagnosis's path imports scipy before it, issue 36; without the call, the
-Table 1 case took 0.5 s more wall and 1 s more CPU). The limit is the process's, and
+import is followed by `blas_loaded` (scipy's, which the polish loaded through `scipy.optimize`
+until issue 36's tenth session; without the call, the Table 1 case took 0.5 s more wall and 1 s
+more CPU; a diagnosis no longer imports scipy.optimize or scipy.linalg). The limit is the process's, and
 threadpoolctl lets one thread at a time control it (the others' calls do nothing): where
 several threads run blocks at once, those other than the first may run beside BLAS's own pool,
 slower.

@@ -25,9 +25,10 @@ def _solve(fun, x0, **kw):
     return levenberg_marquardt(fun, x0, fun(x0[None, :])[0], **kw)
 
 
+@pytest.mark.parametrize("scaling", ["marquardt", "identity"])
 @pytest.mark.parametrize("x0", [(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45)])
-def test_reaches_the_minimum_scipy_reaches(x0):
-    res = _solve(_decay, x0, step=1e-6, max_nfev=200)
+def test_reaches_the_minimum_scipy_reaches(x0, scaling):
+    res = _solve(_decay, x0, step=1e-6, max_nfev=200, scaling=scaling)
     ref = least_squares(lambda x: _decay(x)[0], x0, bounds=(0.0, 1.0), method="trf")
     assert res.f == pytest.approx(2.0 * ref.cost, abs=1e-12)
     np.testing.assert_allclose(res.x, ref.x, atol=1e-5)
@@ -132,3 +133,14 @@ def test_steps_shorter_than_min_secant_leave_the_jacobian_alone():
     np.testing.assert_allclose(res.x, [0.7, 0.4, 0.55], atol=1e-5)
     assert res.status in ("ftol", "xtol")
 
+
+
+def test_isotropic_damping_differs_from_marquardts_and_an_unknown_one_is_refused():
+    # the same start, two dampings: different paths (D = max diag·I against diag(JᵀJ)) to one minimum
+    x0 = np.array([0.2, 0.8, 0.6])
+    a = _solve(_decay, x0, step=1e-6, max_nfev=200)
+    b = _solve(_decay, x0, step=1e-6, max_nfev=200, scaling="identity")
+    assert (a.nfev, a.njev) != (b.nfev, b.njev)
+    np.testing.assert_allclose(a.x, b.x, atol=1e-5)
+    with pytest.raises(ValueError, match="scaling"):
+        _solve(_decay, x0, step=1e-6, max_nfev=5, scaling="levenberg")

@@ -392,3 +392,12 @@ def test_the_packaged_interval_calibration_cannot_be_poisoned_by_a_caller():
     first.record["created"] = "changed"
     again = load_factors()
     assert again.record["created"] != "changed" and np.all(again.scale < 99.0)
+
+
+def test_the_sandwich_fft_length_is_scipys_next_fast_len():
+    from scipy.fft import next_fast_len
+
+    from emaphm.identification.uncertainty.laplace import _five_smooth
+
+    for n in [*range(1, 3000), 10_001, 10_240, 12_289, 65_537]:
+        assert _five_smooth(n) == next_fast_len(n, real=True), n

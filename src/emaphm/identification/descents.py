@@ -40,11 +40,9 @@ def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
     (`lm.levenberg_marquardt`), from one start.
 
     The same residuals, Jacobian step and budget (`limits.LS_STEP`, `limits.LS_MAX_NFEV`); it
-    keeps the start if it does not improve on it. scipy's trust-region method works on the
-    10⁴ × 8 Jacobian itself and pays for it on every call (`lm`'s docstring); the search's last
-    polish and the last stage keep it, whose estimates the interval and detection calibrations
-    were fitted to (a Levenberg–Marquardt there moved the final %err by +0.08 ± 0.05 on 80 paired
-    runs, BENCHMARKS.md, issue 36).
+    keeps the start if it does not improve on it. Marquardt's scaling and secant Jacobians
+    (`limits.LS_BROYDEN`), where `least_squares_polish` (the search's last polish, the last stage)
+    damps isotropically and takes a difference Jacobian at every accepted point.
     """
     return lm_polish_many(residuals, [start])[0]
 

@@ -1,11 +1,15 @@
-"""A bounded Levenberg–Marquardt least-squares solver: the runner-ups' polish
-and the multistart's descents (`descents.lm_polish_many`).
+"""A bounded Levenberg–Marquardt least-squares solver: the runner-ups' polish and the multistart's
+descents (`descents.lm_polish_many`), the search's last polish and the last stage's
+(`polish.least_squares_polish`), the current's scale refits (`current_scale`).
 
 Minimises f(x) = Σ r(x)² over the box [lower, upper]^n, where r is a residual vector of m ≫ n
 samples (eq. 3's √w·(I_ref − I_LF), m ≈ 10⁴, n = 8) and its Jacobian J is taken by forward
 differences in one batch of n rows. Each iteration works on the n × n normal equations only,
 
     (JᵀJ + μ·D) δ = −Jᵀr,     D = diag(JᵀJ)       (Marquardt's scaling, invariant to the units of x)
+
+or, with ``scaling="identity"``, D = max(diag(JᵀJ))·I (Levenberg's isotropic damping: a spherical
+trust region in x, the least-squares polish's, `polish.least_squares_polish`),
 
 with the damping μ updated from the gain ratio ρ = actual / predicted reduction (Nielsen's rule:
 μ·max(1/3, 1 − (2ρ − 1)³) on success, μ·ν, ν·2 on failure). A step is projected into the box; a
@@ -27,8 +31,10 @@ Why not `scipy.optimize.least_squares`: its trust-region reflective method works
 Jacobian itself (an SVD and several m × n products per iteration): measured on a random case
 (bench_multifault seed 6061, case 1) 0.54 s of a 0.68 s polish was the solver's own arithmetic,
 0.09 s the 111 monitor runs (with one BLAS thread, as inside `identify`, 0.07 s against this
-solver's 0.04 s). The normal equations lose precision only when JᵀJ is ill-conditioned beyond
-~1e8, where the damping keeps the step bounded anyway.
+solver's 0.04 s); and importing scipy.optimize alone was 0.56–0.75 s of a diagnosis on machine
+E (issue 36), so since its tenth session every polish of `identify` runs here. The normal
+equations lose precision only when JᵀJ is ill-conditioned beyond ~1e8, where the damping keeps
+the step bounded anyway.
 """
 
 from __future__ import annotations
@@ -39,10 +45,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BROYDEN_REFRESH", "LmResult", "forward_probes", "levenberg_marquardt", "levenberg_marquardt_many"]
+__all__ = ["BROYDEN_REFRESH", "SCALINGS", "LmResult", "forward_probes", "levenberg_marquardt", "levenberg_marquardt_many"]
 
 Batch = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 
+# D of the normal equations (the module docstring)
+SCALINGS = ("marquardt", "identity")
 # with ``broyden``: a difference Jacobian after this many accepted steps on secant updates
 BROYDEN_REFRESH = 4
 
@@ -88,7 +96,10 @@ class _Descent:
 
     def __init__(self, x0: NDArray[np.float64], r0: NDArray[np.float64], step: float, max_nfev: int,
                  lower: float, upper: float, ftol: float, xtol: float, mu0: float, broyden: bool = False,
-                 min_secant: float = 0.0) -> None:  # fmt: skip
+                 min_secant: float = 0.0, scaling: str = "marquardt") -> None:  # fmt: skip
+        if scaling not in SCALINGS:
+            raise ValueError(f"unknown scaling {scaling!r}; use one of {SCALINGS}")
+        self.scaling = scaling
         self.x = np.clip(np.asarray(x0, dtype=np.float64), lower, upper)
         self.r = np.asarray(r0, dtype=np.float64)
         self.f = _sum_sq(self.r)
@@ -120,6 +131,8 @@ class _Descent:
         held = ((self.x <= self.lower) & (self.g > 0.0)) | ((self.x >= self.upper) & (self.g < 0.0))
         self.free = ~held
         d = np.diag(self.A).copy()
+        if self.scaling == "identity":
+            d[:] = max(float(d.max()), 1e-300)
         self.d = np.maximum(d, 1e-12 * max(float(d.max()), 1e-300))
 
     def _secant(self, s: NDArray[np.float64], r_new: NDArray[np.float64]) -> None:
@@ -210,6 +223,7 @@ def levenberg_marquardt_many(
     on_round: Callable[[int, int], None] | None = None,
     broyden: bool = False,
     min_secant: float = 0.0,
+    scaling: str = "marquardt",
 ) -> list[LmResult]:
     """`levenberg_marquardt` from each row of X0 (R0: their residuals), in lockstep: every round
     evaluates what each running descent needs next (a Jacobian's n rows or one trial point) in one
@@ -219,9 +233,10 @@ def levenberg_marquardt_many(
     `fill` (one value per descent, optional): what a residual that is not finite becomes in that
     descent's rows (a trial point that diverges is then rejected), as a caller of
     `levenberg_marquardt` does in its own `batch`. `on_round(stopped, total)` follows the rounds.
-    `broyden`, `min_secant`: secant updates of the Jacobian (the module docstring).
+    `broyden`, `min_secant`: secant updates of the Jacobian; `scaling`: the damping's D (the
+    module docstring).
     """
-    descents = [_Descent(x0, r0, step, max_nfev, lower, upper, ftol, xtol, mu0, broyden, min_secant)
+    descents = [_Descent(x0, r0, step, max_nfev, lower, upper, ftol, xtol, mu0, broyden, min_secant, scaling)
                 for x0, r0 in zip(X0, R0, strict=True)]  # fmt: skip
     while True:
         wanted = [(j, d, d.rows()) for j, d in enumerate(descents)]
@@ -254,6 +269,7 @@ def levenberg_marquardt(
     mu0: float = 1e-3,
     broyden: bool = False,
     min_secant: float = 0.0,
+    scaling: str = "marquardt",
 ) -> LmResult:
     """Minimise Σ r(x)² from x0 (in the box), r0 = r(x0), by bounded Levenberg–Marquardt.
 
@@ -261,10 +277,10 @@ def levenberg_marquardt(
     replaces a diverged run's residual by a large one). Stops when an accepted step lowers f by
     less than `ftol`·f while predicting no more, when a step is below `xtol`·(xtol + |x|), or
     after `max_nfev` trial points. With `broyden`, accepted steps longer than `min_secant` update
-    the Jacobian by secants (the module docstring).
+    the Jacobian by secants; `scaling` is the damping's D (the module docstring).
     """
     return levenberg_marquardt_many(
         batch, np.asarray(x0, dtype=np.float64)[None, :], np.asarray(r0, dtype=np.float64)[None, :], step=step,
         max_nfev=max_nfev, lower=lower, upper=upper, ftol=ftol, xtol=xtol, mu0=mu0, broyden=broyden,
-        min_secant=min_secant,
+        min_secant=min_secant, scaling=scaling,
     )[0]  # fmt: skip

@@ -5,25 +5,22 @@ then a CMA-ES in the Gauss–Newton Hessian's round coordinates, `preconditioned
 small CMA-ES of `polish`) and its distinct runner-ups from the final population by least squares
 on eq. 3's residual vector (`candidates`, `polish_runner_ups`: bounded Levenberg–Marquardt
 descents in lockstep, `descents`), and keeps the best; after the final checks (`checks`),
-`least_squares_stage` ends the search with scipy's bounded least squares on the same residuals
-(`least_squares_polish`), its Jacobian one batch per iteration. Both run only with the settings'
-``polish``; after the multistart search (whose points are least-squares end points) the first
-does nothing.
+`least_squares_stage` ends the search with a bounded least squares on the same residuals
+(`least_squares_polish`: Levenberg–Marquardt with isotropic damping), its Jacobian one batch per
+iteration. Both run only with the settings' ``polish``; after the multistart search (whose
+points are least-squares end points) the first does nothing.
 """
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from numpy.typing import NDArray
 
-from .._threads import blas_loaded
 from . import limits
 from .cmaes import cmaes
 from .context import Context
 from .descents import candidates, diverged_fill, lm_polish_many
-from .lm import forward_probes
+from .lm import levenberg_marquardt
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -108,63 +105,37 @@ def least_squares_polish(
     step: float | None = None,
     max_nfev: int | None = None,
 ) -> OptimizerRun:
-    """Refine a point by nonlinear least squares on its residual vector (scipy's trust-region
-    reflective `least_squares` within the unit box), the objective being Σ r².
+    """Refine a point by nonlinear least squares on its residual vector within the unit box, the
+    objective being Σ r²: a bounded Levenberg–Marquardt with Levenberg's isotropic damping
+    (`lm.levenberg_marquardt`, ``scaling="identity"``: a spherical trust region, as scipy's
+    trust-region reflective `least_squares` with an isotropic ``x_scale``, which this polish ran
+    until issue 36's tenth session), a difference Jacobian at every accepted point.
 
     Where the fitness is a long curved valley in several faults at once, the CMA-ES polish stops
     before its end: measured on a random case (bench_multifault, seed 2027, case 15 seed 2) a run
     ended with the eccentricity at 0.020 against 0.047, at 1.23x the best fitness other seeds
     found, with the fitness falling all along the straight line to their point; this polish went
     there in 84 evaluations. The Jacobian is taken by forward differences of `step` in one batch
-    of n rows from the residual of the point itself, which scipy has just evaluated (backward at
-    the upper bound; `step` and `max_nfev` default to `limits.LS_STEP` and `limits.LS_MAX_NFEV`).
-    Keeps the start if the polish does not improve
+    of n rows (backward at the upper bound; `step` and `max_nfev`, the trial points, default to
+    `limits.LS_STEP` and `limits.LS_MAX_NFEV`). Keeps the start if the polish does not improve
     on it, or fails. A residual that is not finite is replaced by a large one: a trial point that
     diverges is rejected; a Jacobian probe that diverges spoils its column, and the step it
     proposes then rarely fits better, so the start is kept. The history continues the start's.
+    Why not scipy's any more: importing scipy.optimize was 0.56–0.75 s of every diagnosis on
+    machine E (BENCHMARKS.md, issue 36, tenth session).
     """
-    fresh = "scipy.optimize" not in sys.modules
-    from scipy.optimize import least_squares
-
-    if fresh:  # scipy's BLAS has just loaded, inside the caller's numba_threads block
-        blas_loaded()
     step = limits.LS_STEP if step is None else step
     max_nfev = limits.LS_MAX_NFEV if max_nfev is None else max_nfev
-
     x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
-    n = len(x0)
     counted = CountedResiduals(residuals, x0)
-    batch, finite, r0 = counted.batch, counted.finite, counted.r0
-    if not np.all(np.isfinite(r0)):
+    if not np.all(np.isfinite(counted.r0)):
         return counted.kept(start)
-
-    # the point scipy evaluated last and its residual: it evaluates its start once more, and takes
-    # the Jacobian at the point it has just evaluated and accepted
-    last_x, last_r = x0, r0
-
-    def at(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        nonlocal last_x, last_r
-        if not np.array_equal(x, last_x):
-            last_x, last_r = np.array(x, dtype=np.float64), batch(x[None, :])[0]
-        return last_r
-
-    def fun(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        return finite(at(x))
-
-    def jac(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        base = finite(at(x))
-        X, h = forward_probes(x, step)
-        R = finite(batch(X))
-        return ((R - base) / h[:, None]).T  # type: ignore[no-any-return]
-
     try:
-        res = least_squares(
-            fun, x0, jac=jac, bounds=(np.zeros(n), np.ones(n)), method="trf", x_scale=np.full(n, 0.05),
-            max_nfev=max_nfev,
-        )  # fmt: skip
+        res = levenberg_marquardt(lambda X: counted.finite(counted.batch(X)), x0, counted.r0, step=step,
+                                  max_nfev=max_nfev, scaling="identity")  # fmt: skip
     except (ValueError, np.linalg.LinAlgError):
         return counted.kept(start)
-    return counted.kept(start, np.asarray(res.x, dtype=np.float64), 2.0 * float(res.cost))
+    return counted.kept(start, res.x, res.f)
 
 
 def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: OptimizerRun, kept: OptimizerRun,
