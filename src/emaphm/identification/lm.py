@@ -16,11 +16,11 @@ with the damping μ updated from the gain ratio ρ = actual / predicted reductio
 variable at a bound whose gradient points out of the box is held there for that step.
 
 With ``broyden`` (the secant version of Madsen, Nielsen & Tingleff, *Methods for non-linear least
-squares problems*, 2004, §3.4), each trial step h updates J by Broyden's rank-one secant
+squares problems*, 2004, §3.4), each accepted step h updates J by Broyden's rank-one secant
 
     J ← J + (r(x + h) − r(x) − J h) hᵀ / (hᵀh)
 
-after each accepted step instead of a new finite-difference Jacobian (n monitor runs saved).
+instead of a new finite-difference Jacobian (n monitor runs saved; a rejected step leaves J).
 A difference Jacobian is taken at the start, after `BROYDEN_REFRESH` accepted steps on secants,
 after two rejected steps in a row, and before the descent would stop on a secant Jacobian (so
 that it stops where a difference Jacobian sees no descent). A step shorter than `min_secant` does
@@ -112,7 +112,7 @@ class _Descent:
         self.result: LmResult | None = None
         self.h: NDArray[np.float64] | None = None  # the Jacobian's steps while one is requested
         self.x_new: NDArray[np.float64] | None = None  # the trial point while one is requested
-        self.J: NDArray[np.float64] | None = None  # m × n, kept with ``broyden``
+        self.J: NDArray[np.float64] | None = None  # Jᵀ (n × m), kept with ``broyden``
         self.A = self.g = self.d = self.free = None
         if not self.nfev < self.max_nfev:
             self._stop("budget")
@@ -124,7 +124,7 @@ class _Descent:
         self.result = LmResult(self.x, self.f, self.nfev, self.njev, status)
 
     def _normal_equations(self, Jt: NDArray[np.float64]) -> None:
-        """JᵀJ, Jᵀr, the variables held at a bound and Marquardt's scaling from Jᵀ (n × m) at x."""
+        """JᵀJ, Jᵀr, the variables held at a bound and the damping's D from Jᵀ (n × m) at x."""
         # einsum, not BLAS: the same sums in the same order whatever BLAS's threads (a 1e-16
         # difference flips an accept/reject near the end and moves the path: review of issue 36)
         self.A, self.g = np.einsum("ik,jk->ij", Jt, Jt), np.einsum("ik,k->i", Jt, self.r)
