@@ -5,8 +5,8 @@
 Runs the Table 1 case (``emaphm identify --true-faults <Table 1> --seed S``) through the CLI
 --repeats times in this one process, with each stage of the search (`search.SEARCH_STAGES`) and
 of the identification after it (`identifier.AFTER_SEARCH`) timed. The first run pays what a
-fresh process pays (the imports after the CLI's, the kernels' first calls, scipy.optimize for the
-last polish); later runs show the stages warm. Prints for each run the time from this script's
+fresh process pays (the imports after the CLI's, the kernels' first calls; until the tenth session
+scipy.optimize for the last polish); later runs show the stages warm. Prints for each run the time from this script's
 start (or from the run's start) to `api.identify`, to `FaultIdentifier.fit`, the fit, what follows
 it, each stage's wall time and the monitor evaluations. Not a benchmark: one process, no pairing
 (the paired figures are `farm-bench`'s, BENCHMARKS.md "Issue 36").
@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import json
 import time
 
 T0 = time.perf_counter()
@@ -66,7 +67,7 @@ def main(argv: list[str] | None = None) -> None:
         with contextlib.redirect_stdout(out), contextlib.suppress(SystemExit):
             cli.main(argv_cli)
         end = time.perf_counter()
-        evaluations = __import__("json").loads(out.getvalue())["evaluations"]
+        evaluations = json.loads(out.getvalue())["evaluations"]
         print(f"run {r + 1}{' (from the script start)' if r == 0 else ''}: to identify {marks['identify'] - start:.3f} s, "
               f"to the fit {marks['fit'] - marks['identify']:.3f} s, the fit {marks['fit end'] - marks['fit']:.3f} s, "
               f"after it {end - marks['fit end']:.3f} s; {evaluations} evaluations")  # fmt: skip

@@ -9,10 +9,10 @@ same numbers). The matrices here are small (8 columns), so one BLAS thread loses
 block is entered (numpy's), and those a module imported inside the block loads, where that
 import is followed by `blas_loaded` (scipy's, which the polish loaded through `scipy.optimize`
 until issue 36's tenth session; without the call, the Table 1 case took 0.5 s more wall and 1 s
-more CPU; a diagnosis no longer imports scipy.optimize or scipy.linalg). The limit is the process's, and
-threadpoolctl lets one thread at a time control it (the others' calls do nothing): where
-several threads run blocks at once, those other than the first may run beside BLAS's own pool,
-slower.
+more CPU; a diagnosis no longer imports scipy.optimize or scipy.linalg). The limit is the
+process's, and threadpoolctl lets one thread at a time control it (the others' calls do
+nothing): where several threads run blocks at once, those other than the first may run beside
+BLAS's own pool, slower.
 """
 
 from __future__ import annotations

@@ -48,12 +48,21 @@ def lm_polish(residuals: Residuals, start: OptimizerRun) -> OptimizerRun:
 
 
 def lm_polish_many(
-    residuals: Residuals, starts: list[OptimizerRun], on_round: Callable[[int, int], None] | None = None
+    residuals: Residuals,
+    starts: list[OptimizerRun],
+    on_round: Callable[[int, int], None] | None = None,
+    *,
+    step: float | None = None,
+    max_nfev: int | None = None,
+    broyden: bool | None = None,
+    scaling: str = "marquardt",
 ) -> list[OptimizerRun]:
     """`lm_polish` of each start, the descents in lockstep (`lm.levenberg_marquardt_many`: one
     batch of monitor runs per round, each descent on the path it takes alone): the same points,
     values and counts as one by one. A start whose residual is not finite is kept as it is.
-    `on_round(stopped, total)` follows the rounds."""
+    `on_round(stopped, total)` follows the rounds. `step`, `max_nfev` and `broyden` default to
+    `limits.LS_STEP`, `limits.LS_MAX_NFEV` and `limits.LS_BROYDEN`; `scaling` is the damping's
+    (`lm`; `polish.least_squares_polish` asks for "identity" without secants)."""
     if not starts:
         return []
     X0 = np.array([np.clip(np.asarray(s.x, dtype=np.float64), 0.0, 1.0) for s in starts])
@@ -65,9 +74,11 @@ def lm_polish_many(
         fill = np.array([diverged_fill(R0[j]) for j in ok])
         try:
             results = levenberg_marquardt_many(
-                lambda X: np.asarray(residuals(X), dtype=np.float64), X0[ok], R0[ok], step=limits.LS_STEP,
-                max_nfev=limits.LS_MAX_NFEV, fill=fill, on_round=on_round, broyden=limits.LS_BROYDEN,
-                min_secant=limits.LS_MIN_SECANT,
+                lambda X: np.asarray(residuals(X), dtype=np.float64), X0[ok], R0[ok],
+                step=limits.LS_STEP if step is None else step,
+                max_nfev=limits.LS_MAX_NFEV if max_nfev is None else max_nfev, fill=fill, on_round=on_round,
+                broyden=limits.LS_BROYDEN if broyden is None else broyden, min_secant=limits.LS_MIN_SECANT,
+                scaling=scaling,
             )  # fmt: skip
         except (ValueError, np.linalg.LinAlgError):
             results = []

@@ -20,7 +20,6 @@ from . import limits
 from .cmaes import cmaes
 from .context import Context
 from .descents import candidates, diverged_fill, lm_polish_many
-from .lm import levenberg_marquardt
 from .optimizers import (
     BatchProblem,
     Objective,
@@ -107,7 +106,7 @@ def least_squares_polish(
 ) -> OptimizerRun:
     """Refine a point by nonlinear least squares on its residual vector within the unit box, the
     objective being Σ r²: a bounded Levenberg–Marquardt with Levenberg's isotropic damping
-    (`lm.levenberg_marquardt`, ``scaling="identity"``: a spherical trust region, as scipy's
+    (`descents.lm_polish_many`, ``scaling="identity"``: a spherical trust region, as scipy's
     trust-region reflective `least_squares` with an isotropic ``x_scale``, which this polish ran
     until issue 36's tenth session), a difference Jacobian at every accepted point.
 
@@ -124,18 +123,7 @@ def least_squares_polish(
     Why not scipy's any more: importing scipy.optimize was 0.56–0.75 s of every diagnosis on
     machine E (BENCHMARKS.md, issue 36, tenth session).
     """
-    step = limits.LS_STEP if step is None else step
-    max_nfev = limits.LS_MAX_NFEV if max_nfev is None else max_nfev
-    x0 = np.clip(np.asarray(start.x, dtype=np.float64), 0.0, 1.0)
-    counted = CountedResiduals(residuals, x0)
-    if not np.all(np.isfinite(counted.r0)):
-        return counted.kept(start)
-    try:
-        res = levenberg_marquardt(lambda X: counted.finite(counted.batch(X)), x0, counted.r0, step=step,
-                                  max_nfev=max_nfev, scaling="identity")  # fmt: skip
-    except (ValueError, np.linalg.LinAlgError):
-        return counted.kept(start)
-    return counted.kept(start, res.x, res.f)
+    return lm_polish_many(residuals, [start], step=step, max_nfev=max_nfev, broyden=False, scaling="identity")[0]
 
 
 def polish_runner_ups(residuals: Residuals, evaluate: Objective, search: OptimizerRun, kept: OptimizerRun,
