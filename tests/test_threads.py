@@ -93,3 +93,27 @@ def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
     assert out[0] == "False" and out[1] == "[]", out
     assert out[2:4] == ["True", "0"], out  # loaded from the cache, not compiled
     assert out[4] == "1.0"
+
+
+def test_thread_map_starts_the_costliest_first_and_returns_in_the_items_order():
+    import threading
+    import time
+
+    from emaphm._threads import thread_map
+
+    started: list[str] = []
+    lock = threading.Lock()
+
+    def run(item: str) -> str:
+        with lock:
+            started.append(item)
+        time.sleep(0.01)
+        return item.upper()
+
+    items = ["a", "b", "c"]
+    assert thread_map(run, items, 2, costs=[2.0, 2.5, 4.0]) == ["A", "B", "C"]
+    assert sorted(started) == items and started[-1] == "a"  # the cheapest waits for a free thread
+    started.clear()
+    assert thread_map(run, items, 2) == ["A", "B", "C"] and started[-1] == "c"  # no costs: in order
+    with pytest.raises(InputError, match="costs has 2 values for 3 items"):
+        thread_map(run, items, 2, costs=[1.0, 2.0])

@@ -15,6 +15,7 @@ from emaphm.kernels.monitor import (
     phi_sc,
     phi_t,
     simulate_lf,
+    simulate_lf2,
     simulate_lf_many,
     unbalance,
     unbalance_2,
@@ -141,6 +142,35 @@ def test_population_kernel_is_bit_identical_to_single_runs():
     assert not np.array_equal(many[0], many[1])
 
 
+def test_interleaved_pairs_are_bit_identical_to_single_runs_of_any_two_rows():
+    # the pair kernel steps two rows in one loop (issue 36); every row must still be simulate_lf's
+    # to the bit, whatever the two rows' drives, monitor structures and steps per sample
+    from emaphm.params import EmaParams, InverterParams
+
+    K = np.random.default_rng(11).uniform(0, 1, (4, 8))
+    hysteresis = MonitorEma().rows(K)
+    foc = MonitorEma(EmaParams(inverter=InverterParams(control="foc")), allow_mismatch=True).rows(K)
+    paper = MonitorEma(monitor="paper").rows(K)
+    two_steps = hysteresis[3].copy()
+    two_steps[IDX["n_lf"]] = 2.0
+    _, theta_cmd = MonitorEma().sample_grid(0.3)
+    no_aux = np.empty((0, N_AUX))
+
+    def single(row):
+        out = np.empty(len(theta_cmd))
+        simulate_lf(theta_cmd, row, out, no_aux)
+        return out
+
+    pairs = [(hysteresis[0], foc[1]), (foc[2], paper[0]), (paper[1], hysteresis[2]), (two_steps, hysteresis[1]),
+             (hysteresis[0], hysteresis[0])]  # fmt: skip
+    for a, b in pairs:
+        out_a, out_b = np.full(len(theta_cmd), np.nan), np.full(len(theta_cmd), np.nan)
+        simulate_lf2(theta_cmd, a, b, out_a, out_b)
+        np.testing.assert_array_equal(out_a, single(a))
+        np.testing.assert_array_equal(out_b, single(b))
+    assert not np.array_equal(single(hysteresis[0]), single(foc[1]))  # the pairs mixed different runs
+
+
 def test_index_constants_match_the_row_layout():
     # the kernel reads a row through hand-written constants (F_S, J, ..., N_LF); each must be the
     # position of its field in LF_FIELDS, or the LF model silently reads the wrong physics (A3)
@@ -149,7 +179,7 @@ def test_index_constants_match_the_row_layout():
     for j, name in enumerate(LF_FIELDS):
         assert getattr(lf_kernel, name.upper()) == j, name
     # and no other upper-case integer constant pretends to be a field index
-    others = {"N_FIELDS", "N_AUX"}
+    others = {"N_FIELDS", "N_AUX", "PAIR_MIN_ROWS"}
     constants = {n for n, v in vars(lf_kernel).items() if n.isupper() and type(v) is int and n not in others}
     assert constants == {name.upper() for name in LF_FIELDS}
 

@@ -128,7 +128,7 @@ def _quick_load(dispatcher: Any) -> Any:
     return dispatcher
 
 
-def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False) -> Any:
+def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False, inline: bool = False) -> Any:
     """``numba.njit`` with the project's settings; with `nogil` the compiled function releases
     the GIL, so Python threads run it side by side (`HighFidelityEma.simulate_batch`).
 
@@ -137,7 +137,8 @@ def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False) -> 
     (the API validates the divisors, and the model layer checks outputs for NaN/inf);
     ``fastmath`` stays off so results are bit-reproducible.
     """
-    decorator = njit(cache=CACHE_ENABLED, parallel=parallel, nogil=nogil, error_model="numpy")
+    options = {"inline": "always"} if inline else {}
+    decorator = njit(cache=CACHE_ENABLED, parallel=parallel, nogil=nogil, error_model="numpy", **options)
 
     def cached(f: F) -> Any:
         return _quick_load(decorator(f))

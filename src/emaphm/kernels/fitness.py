@@ -33,7 +33,7 @@ import numpy as np
 from numba import prange
 
 from ._jit import jit
-from .monitor import N_AUX, simulate_lf
+from .monitor import N_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
 
@@ -248,10 +248,10 @@ def simulate_pair(theta_cmd, prm, r, pair, pad):  # type: ignore[no-untyped-def]
     n = theta_cmd.shape[0]
     no_aux = np.empty((0, N_AUX))
     buf = np.empty((2, n + 2 * pad))
-    simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
-    if pair:
-        simulate_lf(theta_cmd, prm[r + 1], buf[1, pad : pad + n], no_aux)
+    if pair:  # the two runs interleaved (`simulate_lf2`: the same currents, to the bit)
+        simulate_lf2(theta_cmd, prm[r], prm[r + 1], buf[0, pad : pad + n], buf[1, pad : pad + n])
     else:
+        simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
         buf[1, :] = 0.0
     return buf
 
