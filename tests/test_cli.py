@@ -575,3 +575,30 @@ def test_the_printed_diagnosis_names_the_actuator_and_calibrations_it_rests_on(t
     cal = Path(__file__).resolve().parents[1] / "benchmarks" / "actuators" / "foc-textbook.cal.json"
     code, _, err = run_cli(["identify", "--calibration", str(cal), "--true-faults", "0,0,0,0,0,0,0,0.5"], capsys)
     assert code == 2 and "a foc drive" in err and "pass the actuator file it was made for (--params" in err
+
+
+def test_a_command_runs_from_an_app_of_its_own_with_the_same_command_line(capsys):
+    # main() builds only the command asked for (issue 36); its help and usage errors must be the
+    # full app's, and anything that is not a command name gets the full app
+    import typer.main
+
+    from emaphm import cli
+
+    one = cli._app_for(["identify", "--help"])
+    assert one is not cli.app and cli._app_for(["--help"]) is cli.app and cli._app_for(["idntify"]) is cli.app
+    assert set(typer.main.get_command(one).commands) == {"identify"}
+    assert set(typer.main.get_command(cli.app).commands) == set(cli.NAMES)
+
+    def help_of(app):
+        with pytest.raises(SystemExit):
+            app(args=["identify", "--help"], prog_name="emaphm")
+        return capsys.readouterr().out
+
+    assert "--true-faults" in help_of(one) and help_of(one) == help_of(cli.app)
+    for argv in (["identify", "--bogus"], ["campaign", "run"]):
+        with pytest.raises(SystemExit) as full:
+            cli.app(args=argv, prog_name="emaphm")
+        expected = capsys.readouterr().err
+        with pytest.raises(SystemExit) as alone:
+            cli._app_for(argv)(args=argv, prog_name="emaphm")
+        assert (alone.value.code, capsys.readouterr().err) == (full.value.code, expected) and expected
