@@ -75,9 +75,9 @@ def thread_map(
 
     With `costs` (one per item, any unit) the items are started costliest first and the results
     still come back in the items' order (the longest-processing-time rule). On 2 threads the
-    switching model's runs at 2, 2.5 and 1.25 µs (500 k, 400 k, 800 k steps over 1 s) then take
-    the wall time of 900 k steps (800 k beside 500 k + 400 k), not 1.2 M (400 k + 800 k beside
-    500 k) in the given order (`last_stage.SwitchingModel`)."""
+    switching model's runs at 2, 2.5 and 1.25 µs (`last_stage.SwitchingModel`; 36, 30 and 42 ms on
+    the Table 1 case, machine E) then end after about 66 ms (42 beside 36 + 30), not 72 (30 + 42
+    beside 36) in the given order."""
     threads = max(1, min(workers, len(items)))
     if threads == 1:
         return [fn(item) for item in items]

@@ -101,12 +101,17 @@ def build_app(names: Sequence[str] | None = None) -> typer.Typer:
 _FULL: list[typer.Typer] = []
 
 
+def _full_app() -> typer.Typer:
+    """The whole command line, built the first time it is asked for."""
+    if not _FULL:
+        _FULL.append(build_app())
+    return _FULL[0]
+
+
 def __getattr__(name: str) -> Any:
-    """`app`, the whole command line, built the first time it is asked for (PEP 562)."""
+    """`app`: `_full_app` (PEP 562: the commands' modules are imported only when it is asked for)."""
     if name == "app":
-        if not _FULL:
-            _FULL.append(build_app())
-        return _FULL[0]
+        return _full_app()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -118,7 +123,7 @@ def _app_for(argv: list[str] | None) -> typer.Typer:
     args = sys.argv[1:] if argv is None else argv
     if args and args[0] in NAMES:
         return build_app([args[0]])
-    return __getattr__("app")  # type: ignore[no-any-return]
+    return _full_app()
 
 
 def _fail(message: str, status: int) -> None:

@@ -136,7 +136,7 @@ def jit(fn: F | None = None, *, parallel: bool = False, nogil: bool = False, inl
     `inline` numba inlines it into its callers itself (``inline="always"``), where LLVM would
     keep a call that passes tuples (`monitor.lf_substep`: 131 ms for 96 runs against 82 ms).
 
-    The on-disk cache keeps compiled code on disk between runs (in `kernel_cache_dir`, keyed by all
+    Compiled code is kept on disk between runs (in `kernel_cache_dir`, keyed by all
     kernel sources); ``error_model="numpy"`` drops the division-by-zero checks from the hot loops
     (the API validates the divisors, and the model layer checks outputs for NaN/inf);
     ``fastmath`` stays off so results are bit-reproducible.

@@ -423,8 +423,9 @@ def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-unty
             acc_b += imb
 
 
-# `simulate_lf_many` runs rows in interleaved pairs from this many rows on (a pair takes about 1.3x
-# one row's time on one thread; on 2 threads, 4 rows as 2 pairs beat 2 rows on each thread)
+# `simulate_lf_many` runs rows in interleaved pairs from this many rows on: a pair took 1.2-1.6x one
+# row's time on one thread (96 rows 53-71 ms in pairs, 82-88 ms one by one, machine E), so on 2
+# threads 4 rows as 2 pairs beat 2 rows on each, while 2 rows as a pair would leave one thread idle
 PAIR_MIN_ROWS = 4
 
 
