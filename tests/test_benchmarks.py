@@ -100,9 +100,11 @@ def test_bench_rul_runs_on_a_tiny_run_to_failure_store(bench, tmp_path, capsys):
         "start  = [0.2, 0.1, 0, 0, 0, 0, 0, 0.5]\ngrowth = [0.04, 0.025, 0, 0, 0, 0, 0, 0]\n"
     )  # six flights of ~0.2 s: backlash is detected at flight 2 and predicted at flight 4
     run_campaign(spec, tmp_path / "store", workers=1)
-    # a 24 x 6 search without polish fits poorly: its diagnoses are doubtful, and left out unless asked
+    # a 24 x 6 search without polish fits poorly: its diagnoses are doubtful (all, or all but one or
+    # two), and left out unless asked, so that no prediction is scored
     bench("bench_rul").main([str(tmp_path / "store"), "--spec", str(spec)])
-    assert "are doubtful" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "are doubtful" in out or ("no prediction at flight" in out and "met: 0 of 0" in out)
     bench("bench_rul").main([str(tmp_path / "store"), "--spec", str(spec), "--include-doubtful"])
     assert "relative accuracy at lambda" in capsys.readouterr().out  # a prediction was scored
 

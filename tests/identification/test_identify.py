@@ -141,8 +141,9 @@ def test_identify_records_what_it_did():
         assert key in data
     assert data["seed"] == 2 and data["optimizer"] == "ga" and data["truth"][0] == 0.3
     assert data["settings"]["noise_seed"] != data["settings"]["optimizer_seed"]
-    # 3 generations of 16, then the 5 other phase orders of the shorts (no polish in TINY)
-    assert data["settings"]["generations_run"] == 3 and data["evaluations"] == 16 * 3 + 8
+    # 16 from the start table, 2 generations of 8 new points (`limits.TABLE_OFFSPRING`), then the 5
+    # other phase orders of the shorts (no polish in TINY)
+    assert data["settings"]["generations_run"] == 3 and data["evaluations"] == 16 + 2 * 8 + 8
     assert data["settings"]["samples_compared"] == 1.0  # the FDI chirp never holds
     assert data["percent_error"] == percent_error(res.estimate, [0.3, 0, 0, 0, 0, 0, 0, 0.5])
     # the shipped thresholds, applied to the estimate, when the monitor explains the measurement;

@@ -213,7 +213,11 @@ def test_the_stage_reports_the_switching_models_fit_at_its_estimate(two_shorts, 
     )
     record = ident.record("last_stage")["switching"]
     assert ident.last_stage_ == "switching" and record["steps_s"] == list(PAPER_STEPS)
-    assert record["iterations"] == limits.SWITCHING_ITERATIONS and record["history"][0] > 0
+    # all its iterations, or fewer where the polish stopped moving the estimate (the record says so)
+    assert record["history"][0] > 0 and len(record["history"]) == record["iterations"] + 1
+    assert record["iterations"] == limits.SWITCHING_ITERATIONS or (
+        1 <= record["iterations"] < limits.SWITCHING_ITERATIONS and "did not move" in record["stopped"]
+    )
     # the same search, then the stage: the switching model fits its estimate no worse than the search's
     assert record["fitness"] <= record["start_fitness"]
     # and the search's own fitness is kept apart: the monitor's eq. 3 at the search's estimate

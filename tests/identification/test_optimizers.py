@@ -187,6 +187,26 @@ def test_runs_to_the_budget_while_improving(name):
     assert len(run.history) == 30
 
 
+def test_the_ga_runs_the_offspring_asked_for_and_still_reaches_the_bowl():
+    # the start table's GA makes half its population new each generation (`limits.TABLE_OFFSPRING`):
+    # each generation evaluates that many rows, and the elitist survival still finds the bowl's bottom
+    sizes = []
+
+    def counted(X):
+        sizes.append(len(X))
+        return bowl(X)
+
+    run = run_optimizer("ga", counted, pop_size=20, generations=50, seed=1, stagnation=NO_EARLY_STOP, offspring=10)
+    assert sizes[0] == 20 and set(sizes[1:]) == {10} and len(sizes) == 50
+    assert run.evaluations == 20 + 49 * 10
+    assert run.f < 1e-2 and np.linalg.norm(run.x - CENTRE) < 0.1
+    full = run_optimizer("ga", bowl, pop_size=20, generations=50, seed=1, stagnation=NO_EARLY_STOP)
+    assert full.evaluations == 20 * 50 and not np.array_equal(full.x, run.x)
+    for name, offspring in (("ga", 0), ("ga", 21), ("de", 10)):
+        with pytest.raises(InputError, match="offspring per generation"):
+            run_optimizer(name, bowl, pop_size=20, generations=5, seed=1, offspring=offspring)
+
+
 def test_the_polish_never_returns_a_worse_point():
     rng = np.random.default_rng(0)
     starts = [OptimizerRun(x, float(bowl(x[None, :])[0]), 0, [0.0]) for x in rng.uniform(0, 1, (2, 8))]

@@ -151,7 +151,9 @@ def test_an_identification_records_its_start_and_the_second_search_starts_unifor
     search = r.settings["stages"][0]
     assert search["start"] == "table" and search["table_rows"] == 512 and search["table_built"] is True
     assert search["generations_run"] == limits.TABLE_GENERATIONS
-    assert r.evaluations > 16 * limits.TABLE_GENERATIONS
+    # the table's GA makes half its population new per generation (`limits.TABLE_OFFSPRING`)
+    assert search["offspring"] == 8 and search["evaluations"] == 16 + (limits.TABLE_GENERATIONS - 1) * 8
+    assert r.evaluations > search["evaluations"]
     # the second search (made to run here) is the uniform GA with its full budget
     monkeypatch.setitem(limits.SECOND_SEARCH_NRMSE, "default", 1e-6)
     r2 = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=None, polish=True, uncertainty="none",

@@ -47,10 +47,12 @@ def run_optimizer(
     on_generation: OnGeneration | None = None,
     residuals: Residuals | None = None,
     initial: NDArray[np.float64] | None = None,
+    offspring: int | None = None,
 ) -> OptimizerRun:
     """Minimise `evaluate` over [0, 1]^n_var with optimiser `name` (one of `OPTIMIZERS`).
 
-    `initial` (pop_size, n_var): the GA's first population (`start_table`; default uniform).
+    `initial` (pop_size, n_var): the GA's first population (`start_table`; default uniform);
+    `offspring`: the GA's new points per generation (default one per member of the population).
 
     Stops at `generations` or when `stagnation` (default `Stagnation()`) says so. "multistart"
     (`multistart.multistart`) needs `residuals` too (rows → residual vectors, Σ r² = `evaluate`);
@@ -71,13 +73,16 @@ def run_optimizer(
                           on_generation=on_generation)  # fmt: skip
     if initial is not None and (name != "ga" or np.shape(initial) != (pop_size, n_var)):
         raise InputError(f"a first population is the GA's, of {pop_size} x {n_var} points")
+    if offspring is not None and (name != "ga" or not 1 <= offspring <= pop_size):
+        raise InputError(f"offspring per generation are the GA's, 1 to its population {pop_size}, got {offspring}")
     stop = stagnation if stagnation is not None else Stagnation()
     rng = np.random.default_rng(seed)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     if name == "gwo":
         return grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
     x, f, history, res = run_pymoo(
-        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng, initial), stop.termination(generations),
+        problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng, initial, offspring),
+        stop.termination(generations),
         generations, seed, on_generation,
     )  # fmt: skip
     pop = res.pop
@@ -87,15 +92,15 @@ def run_optimizer(
 
 def _pymoo_algorithm(
     name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator,
-    initial: NDArray[np.float64] | None = None,
+    initial: NDArray[np.float64] | None = None, offspring: int | None = None,
 ) -> Any:  # fmt: skip
     if name == "ga":
         from pymoo.algorithms.soo.nonconvex.ga import GA
         from pymoo.operators.crossover.pcx import PCX
 
         sampling = {} if initial is None else {"sampling": np.array(initial)}  # an array: the first population
-        return GA(pop_size=pop_size, crossover=PCX(eta=0.5, zeta=0.5), eliminate_duplicates=NumpyDuplicates(),
-                  **sampling)  # fmt: skip
+        return GA(pop_size=pop_size, n_offsprings=offspring, crossover=PCX(eta=0.5, zeta=0.5),
+                  eliminate_duplicates=NumpyDuplicates(), **sampling)  # fmt: skip
     if name == "de":
         from pymoo.algorithms.soo.nonconvex.de import DE
 
@@ -117,19 +122,21 @@ def global_search(state: State | None, context: Context) -> tuple[State, Record]
 
     The GA's first population comes from the start table where the settings' ``start`` says so
     (`start_table.uses_table`), and it then runs `limits.TABLE_GENERATIONS` generations unless
-    the settings give them; the record says which start it took."""
+    the settings give them, of `limits.TABLE_OFFSPRING` x its population new points each; the
+    record says which start it took."""
     s = context.settings
-    initial, generations, started = None, s.generations, {"start": "random"}
+    initial, generations, offspring, started = None, s.generations, None, {"start": "random"}
     theta_cmd = start_table.uses_table(context)
     if theta_cmd is not None:
         pop_size = limits.DEFAULT_BUDGETS["ga"][0] if s.pop_size is None else s.pop_size
         initial, table = start_table.first_population(context, theta_cmd, pop_size, context.on_progress)
         generations = limits.TABLE_GENERATIONS if s.generations is None else s.generations
-        started = {"start": "table", **table}
+        offspring = max(1, round(limits.TABLE_OFFSPRING * pop_size))
+        started = {"start": "table", "offspring": offspring, **table}
     run = run_optimizer(
         s.optimizer, context.evaluate, pop_size=s.pop_size, generations=generations, seed=context.seed,
         stagnation=Stagnation(s.patience, s.rtol), on_generation=context.on_generation,
-        residuals=context.residuals(), initial=initial,
+        residuals=context.residuals(), initial=initial, offspring=offspring,
     )  # fmt: skip
     return State(run), {
         "stage": "search", "optimizer": s.optimizer, "seed": context.seed, "generations_run": len(run.history),

@@ -47,8 +47,9 @@ class IdentifySettings:
     start : {"random", "table", "auto"}
         The GA's first population: uniform ("random", the paper's: 40 generations), or the best
         rows of a table of monitor runs kept per actuator, calibration and command ("table";
-        `identification.start_table`; then `limits.TABLE_GENERATIONS` generations by default;
-        about half the monitor runs, BENCHMARKS.md). "auto" (the default): the table for the
+        `identification.start_table`; then `limits.TABLE_GENERATIONS` generations by default, of
+        `limits.TABLE_OFFSPRING` x the population new points each; about a third of the monitor
+        runs, BENCHMARKS.md). "auto" (the default): the table for the
         built-in commands and for recordings of one of the calibration's commands; uniform
         otherwise, for the other optimisers and with an actuator's own baseline
         (`emaphm.identify`). The interval calibration should be fitted with the same start

@@ -7,7 +7,8 @@ a *start table*. For each recording the table's rows are ranked by eq. 3 between
 measurement and each stored current, on every `TABLE_STEP`-th sample with the recording's own
 weights (`StartTable.ranked`: one pass over the table, no monitor run), and the best `pop_size` rows
 are the GA's first population. The GA then runs `limits.TABLE_GENERATIONS` generations instead of
-its 40 from a uniform population, and the polishes, checks, second search and last stage follow
+its 40 from a uniform population, each of `limits.TABLE_OFFSPRING` x the population new points
+(half; one per member from a uniform population), and the polishes, checks, second search and last stage follow
 as before. The table is only a start: every point it gives is evaluated by the monitor before the
 search keeps it, and a poor fit still starts the second search, which searches from a uniform
 population with the full budget (`second_search`). It is the default first population
