@@ -95,8 +95,8 @@ class IdentifySettings:
         "auto",
         "The GA's first population: 'auto' (default: 'table' for built-in commands and recordings of a "
         "calibrated one, else 'random'), 'table' (the best of 16 384 monitor runs, built once per actuator, "
-        "calibration and command and kept, then 15 generations: about half the monitor runs) or 'random' "
-        "(uniform, 40 generations, the paper's; docs/identification.md).",
+        "calibration and command and kept, then 15 generations of 48 new points: about a third of the monitor "
+        "runs) or 'random' (uniform, 40 generations of 96, the paper's; docs/identification.md).",
         choices=STARTS,
     )
     seed: int = _option(0, "Seed of the optimiser (and of the twin's noise).")
