@@ -26,6 +26,7 @@ progress bars) and `render` (the printed form of each result).
 
 from __future__ import annotations
 
+import functools
 import importlib
 import sys
 from collections.abc import Sequence
@@ -98,14 +99,10 @@ def build_app(names: Sequence[str] | None = None) -> typer.Typer:
     return built
 
 
-_FULL: list[typer.Typer] = []
-
-
+@functools.cache
 def _full_app() -> typer.Typer:
     """The whole command line, built the first time it is asked for."""
-    if not _FULL:
-        _FULL.append(build_app())
-    return _FULL[0]
+    return build_app()
 
 
 def __getattr__(name: str) -> Any:
