@@ -602,3 +602,79 @@ def test_a_command_runs_from_an_app_of_its_own_with_the_same_command_line(capsys
         with pytest.raises(SystemExit) as alone:
             cli._app_for(argv)(args=argv, prog_name="emaphm")
         assert (alone.value.code, capsys.readouterr().err) == (full.value.code, expected) and expected
+
+
+# ---- the process's own exit (issue 36: the interpreter's teardown after the kernels, 0.13 s) ----
+
+
+class _Exited(Exception):
+    """os._exit, caught: its status."""
+
+
+@pytest.mark.parametrize(("code", "status", "said"), [(None, 0, ""), (4, 4, ""), ("a reason", 1, "a reason\n")])
+def test_the_process_ends_by_os_exit_after_the_atexit_functions_and_a_flush(monkeypatch, capsys, code, status, said):
+    import atexit
+    import os
+
+    import emaphm.cli as cli
+
+    ran: list[str] = []
+
+    def exited(s: int) -> None:
+        raise _Exited(s)
+
+    monkeypatch.setattr(cli, "_bare_exit_safe", lambda: True)
+    monkeypatch.setattr(atexit, "_run_exitfuncs", lambda: ran.append("atexit"))
+    monkeypatch.setattr(os, "_exit", exited)
+    print("written before the exit", end="")
+    with pytest.raises(_Exited) as caught:
+        cli._process_exit(code)
+    assert caught.value.args == (status,) and ran == ["atexit"]
+    out, err = capsys.readouterr()
+    assert out == "written before the exit" and err == said
+
+
+def test_the_process_ends_as_usual_where_a_thread_or_a_profiler_may_need_the_interpreter(monkeypatch):
+    import cProfile
+    import os
+    import threading
+
+    import emaphm.cli as cli
+
+    monkeypatch.setattr(os, "_exit", lambda s: pytest.fail("os._exit called"))
+    if not cli._bare_exit_safe():
+        pytest.skip("this test process already has a thread, child or tracer that needs the usual exit")
+    release = threading.Event()
+    worker = threading.Thread(target=release.wait)  # not a daemon: the interpreter would wait for it
+    worker.start()
+    try:
+        assert not cli._bare_exit_safe()
+        with pytest.raises(SystemExit) as caught:
+            cli._process_exit(3)
+        assert caught.value.code == 3
+    finally:
+        release.set()
+        worker.join()
+    assert cli._bare_exit_safe()
+    profiler = cProfile.Profile()
+    profiler.enable()
+    try:
+        unsafe_under_profile = not cli._bare_exit_safe()
+    finally:
+        profiler.disable()
+    assert unsafe_under_profile
+
+
+def test_a_process_run_of_the_command_line_writes_all_its_output_and_its_status(tmp_path):
+    # the whole path from the shell: stdout complete through a pipe, the status and stderr's one line
+    template = subprocess.run([sys.executable, "-m", "emaphm", "params", "--template"], capture_output=True, text=True)
+    assert template.returncode == 0 and "psi_m" in template.stdout and template.stderr == ""
+    from typer.testing import CliRunner
+
+    import emaphm.cli as cli
+
+    assert CliRunner().invoke(cli.app, ["params", "--template"]).output == template.stdout
+    bad = subprocess.run([sys.executable, "-m", "emaphm", "identify", "--true-faults", "2,0"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.count("\n") == 1 and bad.stderr.startswith("emaphm: error: --true-faults")
