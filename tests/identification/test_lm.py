@@ -61,8 +61,9 @@ def test_never_worse_than_its_start_and_keeps_to_the_budget(broyden, budget):
     res = _solve(counted, x0, step=1e-4, max_nfev=budget, broyden=broyden)
     assert res.nfev <= budget and res.status == "budget"
     assert res.f <= f0 * (1.0 + 1e-12)
-    # the trial points counted by nfev, the Jacobians in batches of n rows by njev (and the start)
-    assert sum(calls) == 1 + res.nfev + 3 * res.njev
+    # the trial points counted by nfev, the Jacobians in batches of n rows by njev, the spare trial
+    # points never taken by spared (and the start)
+    assert sum(calls) == 1 + res.nfev + 3 * res.njev + res.spared
 
 
 def test_a_rejected_step_damps_and_retries_without_a_new_jacobian():
@@ -74,7 +75,7 @@ def test_a_rejected_step_damps_and_retries_without_a_new_jacobian():
         sizes.append(len(X))
         return np.arctan(20.0 * (np.atleast_2d(X) - 0.5))
 
-    res = _solve(atan, (0.99,), step=1e-7, max_nfev=100)
+    res = _solve(atan, (0.99,), step=1e-7, max_nfev=100, spare_trials=False)
     assert res.x[0] == pytest.approx(0.5, abs=1e-6)
     trials = sizes[1:]  # after the start: a Jacobian is one row here too, so count by order
     assert res.nfev > res.njev  # some Jacobian was followed by more than one trial point
@@ -144,3 +145,62 @@ def test_isotropic_damping_differs_from_marquardts_and_an_unknown_one_is_refused
     np.testing.assert_allclose(a.x, b.x, atol=1e-5)
     with pytest.raises(ValueError, match="scaling"):
         _solve(_decay, x0, step=1e-6, max_nfev=5, scaling="levenberg")
+
+
+@pytest.mark.parametrize("broyden", [False, True])
+@pytest.mark.parametrize("x0", [(0.5, 0.5, 0.5), (0.2, 0.8, 0.6), (0.9, 0.1, 0.45), (0.1, 0.9, 0.2)])
+def test_a_spare_trial_point_gives_the_same_path_in_fewer_rounds(x0, broyden):
+    # a lone descent's trial point goes with its spare (the trial after a rejection): the same end
+    # point, value, counts and stop as without, to the bit; fewer calls where a step was rejected;
+    # every row evaluated is counted (the spares never taken in `spared`)
+    def run(spare_trials):
+        calls = []
+
+        def counted(X):
+            calls.append(len(X))
+            return np.arctan(5.0 * _decay(X))  # a rough valley: many rejected steps
+
+        x = np.asarray(x0, dtype=float)
+        res = levenberg_marquardt(counted, x, counted(x[None, :])[0], step=1e-4, max_nfev=60, broyden=broyden,
+                                  spare_trials=spare_trials)  # fmt: skip
+        return res, calls[1:]
+
+    plain, plain_calls = run(False)
+    spared, spare_calls = run(True)
+    np.testing.assert_array_equal(spared.x, plain.x)
+    assert (spared.f, spared.nfev, spared.njev, spared.status) == (plain.f, plain.nfev, plain.njev, plain.status)
+    assert plain.spared == 0 and max(plain_calls) <= 3
+    assert sum(spare_calls) == spared.nfev + 3 * spared.njev + spared.spared
+    taken = spare_calls.count(2) - spared.spared  # each spare taken is a round saved
+    assert len(spare_calls) == len(plain_calls) - taken
+
+
+def test_a_spare_taken_saves_the_round_of_a_rejected_step():
+    # the atan fit of the rejected-step test: its damped retries come from the spares
+    def atan(X):
+        sizes.append(len(X))
+        return np.arctan(20.0 * (np.atleast_2d(X) - 0.5))
+
+    ends = {}
+    for spare in (False, True):
+        sizes: list[int] = []
+        ends[spare] = (_solve(atan, (0.99,), step=1e-7, max_nfev=100, spare_trials=spare), len(sizes))
+    (plain, plain_calls), (spared, spare_calls) = ends[False], ends[True]
+    assert (spared.x[0], spared.nfev, spared.njev) == (plain.x[0], plain.nfev, plain.njev)
+    assert spare_calls < plain_calls
+
+
+def test_a_spare_goes_only_with_a_lone_trial_point():
+    # descents in lockstep already fill the batch: no spares there, the same calls as before
+    starts = np.array([(0.5, 0.5, 0.5), (0.2, 0.8, 0.6)])
+    sizes = {True: [], False: []}
+    for spare in (True, False):
+        def counted(X, spare=spare):
+            sizes[spare].append(len(X))
+            return np.arctan(5.0 * _decay(X))
+
+        levenberg_marquardt_many(counted, starts, counted(starts), step=1e-4, max_nfev=40, spare_trials=spare)
+    # while both run, every round is the same; spares appear only once one of them has stopped
+    both = next(i for i, (a, b) in enumerate(zip(sizes[True], sizes[False])) if a != b)
+    assert sizes[True][:both] == sizes[False][:both]
+    assert sizes[True][both] == 2 and sizes[False][both] == 1

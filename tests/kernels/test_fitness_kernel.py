@@ -212,6 +212,19 @@ def test_fused_residuals_equal_the_python_path_and_sum_to_the_fitness(case):
     np.testing.assert_allclose(np.sum(got**2, axis=1), fitness.of_monitor(lf, K, duration=duration), rtol=1e-12)
 
 
+def test_two_rows_one_per_thread_give_the_residuals_of_every_batch():
+    # two rows run one on each thread (a descent's trial point and its spare), other batches in
+    # interleaved pairs: each row's residual is the same to the bit however it is batched
+    lf = MonitorEma()
+    fitness = Fitness(monitor_reference(lf, [0.2, 0.5, 0, 0.45, 0.04, 0, 0.28, 0.5], True, 0.2))
+    K = np.random.default_rng(11).uniform(0, 1, (4, 8))
+    whole = fitness.residuals_of_monitor(lf, K, duration=0.2)
+    for rows in ([0, 1], [2, 3], [3, 0]):
+        np.testing.assert_array_equal(fitness.residuals_of_monitor(lf, K[rows], duration=0.2), whole[rows])
+    np.testing.assert_array_equal(fitness.residuals_of_monitor(lf, K[:1], duration=0.2), whole[:1])
+    np.testing.assert_array_equal(python_residuals(fitness, lf, K[:2], 0.2), whole[:2])
+
+
 def test_a_diverged_row_gets_non_finite_residuals_and_the_others_do_not_change():
     lf = MonitorEma()
     fitness = Fitness(monitor_reference(lf, [0.2, 0.5, 0, 0.45, 0.04, 0, 0.28, 0.5], True, 0.2))

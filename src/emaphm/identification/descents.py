@@ -83,7 +83,7 @@ def lm_polish_many(
         except (ValueError, np.linalg.LinAlgError):
             results = []
         for j, res in zip(ok, results, strict=False):
-            evaluations[j] += res.njev * X0.shape[1] + res.nfev
+            evaluations[j] += res.njev * X0.shape[1] + res.nfev + res.spared
             ends[j] = (res.x, res.f)
     out = []
     for j, start in enumerate(starts):

@@ -285,15 +285,29 @@ def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out)
     runs and filter, rows in interleaved pairs, the same numbers as filtering the currents of
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
     LF current is not finite gets NaN residuals.
+
+    Two rows run one on each thread instead (a pair would leave the other thread idle): a
+    least-squares descent's trial point and its spare (`identification.lm`) cost one row's time.
     """
     n_runs = prm.shape[0]
+    if n_runs == 2:
+        for r in prange(2):
+            buf = simulate_pair(theta_cmd, prm, r, False, pad)
+            sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+            kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
+        return
     for q in prange((n_runs + 1) // 2):
         r = 2 * q
         pair = r + 1 < n_runs
         buf = simulate_pair(theta_cmd, prm, r, pair, pad)
         sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-        for j in range(keep.shape[0]):
-            out[r, j] = root_w[j] * (ref_keep[j] - buf[0, pad + keep[j]])
+        kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
         if pair:
-            for j in range(keep.shape[0]):
-                out[r + 1, j] = root_w[j] * (ref_keep[j] - buf[1, pad + keep[j]])
+            kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
+
+
+@jit
+def kept_residuals(e, pad, keep, ref_keep, root_w, out):  # type: ignore[no-untyped-def]
+    """out = root_w·(ref_keep − e[pad + keep]): eq. 3's residual of one filtered current."""
+    for j in range(keep.shape[0]):
+        out[j] = root_w[j] * (ref_keep[j] - e[pad + keep[j]])
