@@ -16,6 +16,7 @@ from ..errors import InputError
 from ..faults import as_fault_vector
 from . import checks, limits, polish, start_table
 from .context import Context
+from .ga import PCX_ETA, PCX_ZETA, genetic_algorithm
 from .gwo import grey_wolf
 from .multistart import multistart
 from .optimizers import (
@@ -80,6 +81,9 @@ def run_optimizer(
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
     if name == "gwo":
         return grey_wolf(problem, pop_size, generations, rng, stop, on_generation)
+    if name == "ga":  # pymoo's GA on arrays, the same generations to the bit (`ga`)
+        return genetic_algorithm(problem, pop_size, generations, seed, stop, on_generation,
+                                 None if initial is None else np.array(initial), offspring)  # fmt: skip
     x, f, history, res = run_pymoo(
         problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng, initial, offspring),
         stop.termination(generations),
@@ -94,12 +98,14 @@ def _pymoo_algorithm(
     name: str, pop_size: int, generations: int, n_var: int, rng: np.random.Generator,
     initial: NDArray[np.float64] | None = None, offspring: int | None = None,
 ) -> Any:  # fmt: skip
+    """The pymoo algorithm of optimiser `name`; for the GA, which `run_optimizer` runs on arrays
+    (`ga.genetic_algorithm`), the pymoo one that does the same (its reference in the tests)."""
     if name == "ga":
         from pymoo.algorithms.soo.nonconvex.ga import GA
         from pymoo.operators.crossover.pcx import PCX
 
         sampling = {} if initial is None else {"sampling": np.array(initial)}  # an array: the first population
-        return GA(pop_size=pop_size, n_offsprings=offspring, crossover=PCX(eta=0.5, zeta=0.5),
+        return GA(pop_size=pop_size, n_offsprings=offspring, crossover=PCX(eta=PCX_ETA, zeta=PCX_ZETA),
                   eliminate_duplicates=NumpyDuplicates(), **sampling)  # fmt: skip
     if name == "de":
         from pymoo.algorithms.soo.nonconvex.de import DE
