@@ -678,3 +678,29 @@ def test_a_process_run_of_the_command_line_writes_all_its_output_and_its_status(
                          capture_output=True, text=True)  # fmt: skip
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.count("\n") == 1 and bad.stderr.startswith("emaphm: error: --true-faults")
+
+
+def test_stderr_is_rich_console_made_when_first_used(monkeypatch, capsys):
+    # `err` answers "is stderr a terminal?" without rich where it plainly is not (issue 36: rich's
+    # import was 17 ms of every command), and is rich's Console for everything else
+    code = ("import sys; from emaphm.cli.output import err; t = err.is_terminal; "
+            "print(t, 'rich.console' in sys.modules)")  # fmt: skip
+    env = {k: v for k, v in __import__("os").environ.items() if k not in ("FORCE_TERMINAL", "TTY_COMPATIBLE",
+           "FORCE_COLOR", "TTY_INTERACTIVE")}  # fmt: skip
+    plain = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    assert plain.stdout.split() == ["False", "False"]
+    for setting in ("FORCE_TERMINAL", "TTY_COMPATIBLE"):  # rich decides, as it did
+        rich_says = f"; from rich.console import Console; print(Console(stderr=True).is_terminal)"
+        forced = subprocess.run([sys.executable, "-c", code + rich_says], capture_output=True, text=True,
+                                env={**env, setting: "1"}, check=True)  # fmt: skip
+        ours, imported, theirs = forced.stdout.split()
+        assert imported == "True" and ours == theirs
+    assert ours == "True"  # TTY_COMPATIBLE=1: a terminal to rich, whatever the stream
+    from emaphm.cli.output import Stderr
+
+    err = Stderr()
+    err.print("a message [not markup]", markup=False)
+    assert capsys.readouterr().err == "a message [not markup]\n"
+    from rich.console import Console
+
+    assert isinstance(err.console, Console) and err.console is err.console

@@ -7,18 +7,58 @@ CI logs get a line now and then, or nothing.
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
-from typing import Any
-
-from rich.console import Console
+from typing import TYPE_CHECKING, Any
 
 from ..callbacks import Progress
 
+if TYPE_CHECKING:
+    from rich.console import Console
+
 __all__ = ["bracketed", "campaign_progress", "err", "logged", "progress", "status", "stdout_console"]
 
-err = Console(stderr=True, highlight=False, soft_wrap=True)  # messages whole, also in logs
+# what makes rich take a stream for a terminal whatever the stream (`Stderr.is_terminal`)
+TERMINAL_SETTINGS = ("FORCE_TERMINAL", "TTY_COMPATIBLE", "FORCE_COLOR", "TTY_INTERACTIVE")
+
+
+class Stderr:
+    """`err`: rich's Console on stderr (messages whole, also in logs), made when first used.
+
+    Importing rich.console was 17 ms of every command's start on machine G (issue 36), and a
+    command that prints nothing to stderr (``emaphm identify --json`` of a recording that fits)
+    only asks whether stderr is a terminal, for its progress bar. So `is_terminal` is answered
+    without rich where stderr is plainly not one (no terminal, none of rich's `TERMINAL_SETTINGS`
+    set); anything else goes to the Console, the same as before."""
+
+    def __init__(self) -> None:
+        self._console: Console | None = None
+
+    @property
+    def console(self) -> Console:
+        if self._console is None:
+            from rich.console import Console
+
+            self._console = Console(stderr=True, highlight=False, soft_wrap=True)
+        return self._console
+
+    @property
+    def is_terminal(self) -> bool:
+        if self._console is None and not any(os.environ.get(k) is not None for k in TERMINAL_SETTINGS):
+            try:
+                if not sys.stderr.isatty():
+                    return False
+            except (AttributeError, ValueError):  # no stream, or a closed one: rich says False too
+                return False
+        return self.console.is_terminal
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.console, name)
+
+
+err = Stderr()
 
 
 def status(message: str) -> Any:
@@ -28,6 +68,8 @@ def status(message: str) -> Any:
 
 def stdout_console() -> Console:
     """Console for results on stdout; 120 columns when not a terminal, so logs get whole tables."""
+    from rich.console import Console
+
     return Console(highlight=False, width=None if sys.stdout.isatty() else 120)
 
 
@@ -43,7 +85,7 @@ def progress() -> Iterator[Progress]:
 
     import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
 
-    with Progress(console=err, transient=True) as bar:
+    with Progress(console=err.console, transient=True) as bar:
         tasks: dict[str, Any] = {}
 
         def update(stage: str, done: int, total: int) -> None:
@@ -106,7 +148,7 @@ def campaign_progress(name: str) -> Iterator[Callable[[int, int, int, float], No
 
     with Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
-        TimeRemainingColumn(), console=err, transient=True,
+        TimeRemainingColumn(), console=err.console, transient=True,
     ) as bar:  # fmt: skip
         task = bar.add_task(f"campaign {name}", total=None, info="")
 
