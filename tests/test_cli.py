@@ -607,7 +607,7 @@ def test_a_command_runs_from_an_app_of_its_own_with_the_same_command_line(capsys
 # ---- the process's own exit (issue 36: the interpreter's teardown after the kernels, 0.13 s) ----
 
 
-class _Exited(Exception):
+class _ExitedError(Exception):
     """os._exit, caught: its status."""
 
 
@@ -621,13 +621,13 @@ def test_the_process_ends_by_os_exit_after_the_atexit_functions_and_a_flush(monk
     ran: list[str] = []
 
     def exited(s: int) -> None:
-        raise _Exited(s)
+        raise _ExitedError(s)
 
     monkeypatch.setattr(cli, "_bare_exit_safe", lambda: True)
     monkeypatch.setattr(atexit, "_run_exitfuncs", lambda: ran.append("atexit"))
     monkeypatch.setattr(os, "_exit", exited)
     print("written before the exit", end="")
-    with pytest.raises(_Exited) as caught:
+    with pytest.raises(_ExitedError) as caught:
         cli._process_exit(code)
     assert caught.value.args == (status,) and ran == ["atexit"]
     out, err = capsys.readouterr()
@@ -690,7 +690,7 @@ def test_stderr_is_rich_console_made_when_first_used(monkeypatch, capsys):
     plain = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     assert plain.stdout.split() == ["False", "False"]
     for setting in ("FORCE_TERMINAL", "TTY_COMPATIBLE"):  # rich decides, as it did
-        rich_says = f"; from rich.console import Console; print(Console(stderr=True).is_terminal)"
+        rich_says = "; from rich.console import Console; print(Console(stderr=True).is_terminal)"
         forced = subprocess.run([sys.executable, "-c", code + rich_says], capture_output=True, text=True,
                                 env={**env, setting: "1"}, check=True)  # fmt: skip
         ours, imported, theirs = forced.stdout.split()

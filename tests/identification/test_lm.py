@@ -201,6 +201,6 @@ def test_a_spare_goes_only_with_a_lone_trial_point():
 
         levenberg_marquardt_many(counted, starts, counted(starts), step=1e-4, max_nfev=40, spare_trials=spare)
     # while both run, every round is the same; spares appear only once one of them has stopped
-    both = next(i for i, (a, b) in enumerate(zip(sizes[True], sizes[False])) if a != b)
+    both = next(i for i, (a, b) in enumerate(zip(sizes[True], sizes[False], strict=False)) if a != b)
     assert sizes[True][:both] == sizes[False][:both]
     assert sizes[True][both] == 2 and sizes[False][both] == 1

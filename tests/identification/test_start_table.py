@@ -67,7 +67,7 @@ def test_a_table_is_kept_by_its_key_and_read_back_the_same(small, sim):
     ctx = _context(trace)
     theta = start_table.table_command(ctx)
     first, built = start_table.start_table(ctx, theta)
-    assert built and len(list(small.glob("*.npz"))) == 1
+    assert built and len(list(small.glob("*.table"))) == 1
     start_table._MEMORY.clear()
     again, built_again = start_table.start_table(ctx, theta)
     assert not built_again
@@ -80,10 +80,21 @@ def test_a_table_is_kept_by_its_key_and_read_back_the_same(small, sim):
         trace.t, trace.i_q).context_  # fmt: skip
     assert start_table.table_key(other, theta) != first.key
     # a file with another key at that name (a collision, a foreign file) is not taken
-    path = next(small.glob("*.npz"))
-    np.savez(path.open("wb"), X=first.X, T=first.T, index=first.index, key=np.array("x" * 64))
+    path = next(small.glob("*.table"))
+    with path.open("wb") as f:
+        for array in (np.array("x" * 64), first.X, first.index, first.T):
+            np.save(f, array)
     start_table._MEMORY.clear()
     assert start_table.start_table(ctx, theta)[1]
+    # a file cut short (a copy that stopped) is built again too, and replaced by a whole one
+    whole = path.read_bytes()
+    path.write_bytes(whole[: len(whole) // 2])
+    start_table._MEMORY.clear()
+    assert start_table.start_table(ctx, theta)[1] and path.read_bytes() == whole
+    start_table._MEMORY.clear()
+    kept, built = start_table.start_table(ctx, theta)
+    assert not built and isinstance(kept.T, np.memmap)  # read memory-mapped
+    np.testing.assert_array_equal(kept.T, first.T)
 
 
 def test_the_table_folder_keeps_the_most_recently_used_tables_within_its_bound(small, sim, monkeypatch, tmp_path):
@@ -91,14 +102,14 @@ def test_the_table_folder_keeps_the_most_recently_used_tables_within_its_bound(s
 
     folder = tmp_path / "folder"
     folder.mkdir()
-    paths = [folder / f"{c * 32}.npz" for c in "abcd"]
+    paths = [folder / f"{c * 32}{suffix}" for c, suffix in zip("abcd", [".table", ".npz", ".table", ".table"], strict=True)]
     for age, path in enumerate(paths):
         path.write_bytes(b"x" * 2**20)  # 1 MiB each, a the oldest
         os.utime(path, (1000.0 + age, 1000.0 + age))
     os.utime(paths[0], (2000.0, 2000.0))  # a read since: now the newest
     monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", "3.5")
     assert start_table.prune(folder, keep=paths[1]) == [paths[2]]  # b kept as asked, c the oldest after it
-    assert sorted(p.name[0] for p in folder.glob("*.npz")) == ["a", "b", "d"]
+    assert sorted(p.name[0] for p in folder.iterdir()) == ["a", "b", "d"]  # a format-1 .npz counted too
     monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", "0")  # no bound
     assert start_table.prune(folder) == []
     # through `start_table`: a table written beyond the bound removes the older ones, not itself
@@ -109,7 +120,7 @@ def test_the_table_folder_keeps_the_most_recently_used_tables_within_its_bound(s
     os.utime(old, (1000.0, 1000.0))
     ctx = _context(sim(K, ideal=False))
     assert start_table.start_table(ctx, start_table.table_command(ctx))[1]
-    assert not old.exists() and len(list(small.glob("*.npz"))) == 1
+    assert not old.exists() and len(list(small.glob("*.table"))) == 1
 
 
 def test_a_folder_that_cannot_be_written_builds_the_table_in_memory(small, sim, monkeypatch, tmp_path):
@@ -170,7 +181,7 @@ def test_start_auto_is_the_default_random_a_uniform_ga_and_start_table_needs_the
     assert IdentifySettings().start == "auto"
     r = emaphm.identify(reference=trace, seed=1, pop_size=16, generations=3, polish=False, last_stage="none",
                         uncertainty="none", start="random")  # fmt: skip
-    assert r.settings["stages"][0]["start"] == "random" and not list(small.glob("*.npz"))
+    assert r.settings["stages"][0]["start"] == "random" and not list(small.glob("*.table"))
     with pytest.raises(InputError, match="GA's first population"):
         IdentifySettings(optimizer="de", start="table")
     with pytest.raises(InputError, match="unknown start"):
@@ -194,13 +205,13 @@ def test_the_cli_takes_start_and_refuses_an_unknown_one_in_one_line(small, tmp_p
     assert code == 2 and "start" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "no.json").exists()
     # a table folder's bound that is not a number of MiB: refused in one line, no new table, no output
-    tables = sorted(small.glob("*.npz"))
+    tables = sorted(small.glob("*.table"))
     for bad in ("lots", "-1"):
         monkeypatch.setenv("EMAPHM_TABLE_CACHE_MB", bad)
         code, _, err = run_cli(["identify", "--true-faults", "0,0,0,0,0,0,0,0.5", "--pop-size", "8",
                                 "--generations", "2", "--output", str(tmp_path / "no.json")], capsys)  # fmt: skip
         assert code == 2 and "EMAPHM_TABLE_CACHE_MB" in err and len(err.strip().splitlines()) == 1
-        assert not (tmp_path / "no.json").exists() and sorted(small.glob("*.npz")) == tables
+        assert not (tmp_path / "no.json").exists() and sorted(small.glob("*.table")) == tables
 
 
 def test_a_process_keeps_only_the_most_recent_tables_in_memory(small, sim, monkeypatch):

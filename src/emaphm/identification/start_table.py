@@ -26,7 +26,7 @@ A table depends on everything that sets the monitor's current: the monitor's par
 compared span, the comparison filter, the kernels' sources and the table's own layout; its key
 (`table_key`) is a SHA-256 of all of them. Tables are kept in ``$EMAPHM_TABLE_DIR`` when set,
 else ``$XDG_CACHE_HOME/emaphm/start-tables`` (``~/.cache/...``); one is built the first time its
-key is asked for (16 384 monitor runs: 8-11 s on a shared 2-core machine) and written atomically; where no
+key is asked for (16 384 monitor runs: 8-11 s on a shared 2-core machine) and written atomically (`start_table_files`); where no
 folder can be written it is built in memory for the process. The folder is bounded (`prune`: the
 least recently used tables go beyond ``$EMAPHM_TABLE_CACHE_MB``, 2 GiB by default). A baselined
 actuator starts from its nameplate's table (``Context.table_monitor``), shared by its type.
@@ -35,20 +35,18 @@ actuator starts from its nameplate's table (``Context.table_monitor``), shared b
 from __future__ import annotations
 
 import hashlib
-import os
 from collections import OrderedDict
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..callbacks import Progress
-from ..errors import InputError
 from ..kernels.fitness import residuals_lf_many
 from .multistart import latin_hypercube
 from .problem import search_to_faults
+from .start_table_files import TABLE_SUFFIX, cache_limit, prune, read_table, table_dir, write_table
 
 if TYPE_CHECKING:
     from .context import Context
@@ -66,7 +64,9 @@ __all__ = [
     "uses_table",
 ]
 
-TABLE_FORMAT = "emaphm-start-table-1"
+# 2: one file of four .npy arrays (key, X, index, T as float32, memory-mapped when read); 1 was an
+# .npz with T in float16, whose read, check and conversion took 45-140 ms of a diagnosis's start
+TABLE_FORMAT = "emaphm-start-table-2"
 TABLE_ROWS = 16384  # the table's points of the box
 TABLE_STEP = 20  # every TABLE_STEP-th sample of the monitor's grid is stored (the filter passes < 150 Hz)
 TABLE_SEED = 20261201  # the Latin hypercube's seed: a table is a function of its key alone
@@ -75,18 +75,15 @@ BUILD_BATCH = 1024  # monitor runs per kernel call while building (the progress 
 # a new process: 0.15 s in a profile of one identification, against 8-15 ms chunked (the same numbers)
 RANK_CHUNK = 512
 MEMORY_TABLES = 4  # tables a process keeps in memory (33 MB each), the most recently used
-# the table folder is kept under this many MiB (``$EMAPHM_TABLE_CACHE_MB``; 0: no bound): after a
-# table is written, the least recently used ones go (`prune`); a table gone is built again, the same.
-# 2 GiB holds about 120 tables of the 1 s chirp (one per actuator type, calibration and command)
-TABLE_CACHE_MB = 2048
 
 
 @dataclass(frozen=True)
 class StartTable:
     """Monitor runs kept for ranking: the box points ``X`` (n, 8), the filtered currents ``T``
-    (n, m) [A] at the grid samples ``index`` (m,), and the table's ``key``. The currents are kept
-    to half precision (about 1e-3 of their size, far below a fit's residual; 16 MB a table) and
-    held as float32: a table read from the folder ranks exactly as the one just built."""
+    (n, m) [A] at the grid samples ``index`` (m,), and the table's ``key``. The currents are
+    rounded to half precision (about 1e-3 of their size, far below a fit's residual) and held as
+    float32, in the folder too (33 MB a table), which is read memory-mapped: a table read from the
+    folder ranks exactly as the one just built, with no conversion at each process's start."""
 
     X: NDArray[np.float64]
     T: NDArray[np.float32]
@@ -107,15 +104,6 @@ class StartTable:
         count = min(int(count), len(d))
         best = np.argpartition(d, count - 1)[:count]
         return np.array(self.X[best[np.argsort(d[best], kind="stable")]], dtype=np.float64)
-
-
-def table_dir() -> Path:
-    """Where start tables are kept (the module docstring)."""
-    given = os.environ.get("EMAPHM_TABLE_DIR")
-    if given:
-        return Path(given)
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "emaphm" / "start-tables"
 
 
 def _probe_rows() -> NDArray[np.float64]:
@@ -185,58 +173,6 @@ def build_table(
     return StartTable(X[ok], T[ok], index, key if key is not None else table_key(context, theta_cmd))
 
 
-def _load(path: Path, key: str) -> StartTable | None:
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            if str(data["key"]) != key:
-                return None
-            table = StartTable(data["X"], data["T"].astype(np.float32), data["index"].astype(np.intp), key)
-        os.utime(path)  # its use, for `prune`
-        return table
-    except (OSError, ValueError, KeyError):
-        return None  # missing, half-copied or foreign: built again
-
-
-def cache_limit() -> float:
-    """The table folder's bound in bytes: ``$EMAPHM_TABLE_CACHE_MB`` MiB (default `TABLE_CACHE_MB`;
-    0: none); a setting that is not a number of MiB >= 0 is refused in one line."""
-    given = os.environ.get("EMAPHM_TABLE_CACHE_MB", str(TABLE_CACHE_MB))
-    try:
-        mib = float(given)
-    except ValueError:
-        mib = float("nan")
-    if not mib >= 0 or mib == float("inf"):
-        raise InputError(f"EMAPHM_TABLE_CACHE_MB must be a number of MiB (0: no bound), got {given!r}")
-    return mib * 2**20
-
-
-def prune(folder: Path, keep: Path | None = None) -> list[Path]:
-    """Remove the least recently used tables (by modification time: written or read) until the
-    folder's tables take at most `cache_limit` bytes (0: no bound), never `keep`; returns those
-    removed."""
-    limit = cache_limit()
-    kept: list[tuple[float, int, Path]] = []
-    for path in folder.glob("*.npz"):
-        try:
-            st = path.stat()
-        except OSError:
-            continue  # removed by another process meanwhile
-        kept.append((st.st_mtime, st.st_size, path))
-    total, removed = sum(size for _, size, _ in kept), []
-    for _, size, path in sorted(kept):  # the oldest first
-        if limit <= 0 or total <= limit:
-            break
-        if path == keep:
-            continue
-        try:
-            path.unlink()
-        except OSError:
-            continue
-        total -= size
-        removed.append(path)
-    return removed
-
-
 # tables of this process, most recently used last (also those that could not be written); bounded,
 # so that a long-lived campaign worker diagnosing many actuators does not hold all their tables
 _MEMORY: OrderedDict[str, StartTable] = OrderedDict()
@@ -252,28 +188,18 @@ def start_table(
     if key in _MEMORY:
         _MEMORY.move_to_end(key)
         return _MEMORY[key], False
-    path = table_dir() / f"{key[:32]}.npz"
-    table = _load(path, key)
-    built = table is None
-    if table is None:
+    path = table_dir() / f"{key[:32]}{TABLE_SUFFIX}"
+    kept = read_table(path, key)
+    built = kept is None
+    if kept is None:
         table = build_table(context, theta_cmd, key, on_progress)
-        _save(path, table)
+        write_table(path, key, table.X, table.index, table.T)
+    else:
+        table = StartTable(kept[0], kept[1], kept[2], key)
     _MEMORY[key] = table
     while len(_MEMORY) > MEMORY_TABLES:
         _MEMORY.popitem(last=False)
     return table, built
-
-
-def _save(path: Path, table: StartTable) -> None:
-    from ..atomic import atomic_path
-
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp, open(tmp, "wb") as f:
-            np.savez(f, X=table.X, T=table.T.astype(np.float16), index=table.index, key=np.array(table.key))
-        prune(path.parent, keep=path)
-    except OSError:
-        pass  # a folder that cannot be written: the table lives in this process only
 
 
 def uses_table(context: Context) -> NDArray[np.float64] | None:
