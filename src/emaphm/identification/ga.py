@@ -143,13 +143,9 @@ def genetic_algorithm(
 
 
 def mating(
-    rng: np.random.Generator,
-    X: NDArray[np.float64],
-    F: NDArray[np.float64],
-    n_offsprings: int,
-    xl: NDArray[np.float64],
-    xu: NDArray[np.float64],
-) -> NDArray[np.float64]:
+    rng: np.random.Generator, X: NDArray[np.float64], F: NDArray[np.float64], n_offsprings: int,
+    xl: NDArray[np.float64], xu: NDArray[np.float64],
+) -> NDArray[np.float64]:  # fmt: skip
     """pymoo's `Mating.do` (an `InfillCriterion`): matings until `n_offsprings` new points that
     duplicate neither each other nor the population, at most `MAX_MATINGS` rounds."""
     off = np.empty((0, X.shape[1]))
@@ -166,13 +162,9 @@ def mating(
 
 
 def _mate(
-    rng: np.random.Generator,
-    X: NDArray[np.float64],
-    F: NDArray[np.float64],
-    n_matings: int,
-    xl: NDArray[np.float64],
-    xu: NDArray[np.float64],
-) -> NDArray[np.float64]:
+    rng: np.random.Generator, X: NDArray[np.float64], F: NDArray[np.float64], n_matings: int,
+    xl: NDArray[np.float64], xu: NDArray[np.float64],
+) -> NDArray[np.float64]:  # fmt: skip
     """One round of pymoo's `Mating._do`: tournament selection, PCX crossover, PM mutation."""
     n_var = X.shape[1]
     # TournamentSelection: permutations of the population, pairs compared by the fitness
