@@ -149,12 +149,12 @@ def _process_exit(code: object) -> None:
     """End the process with `code` as `sys.exit(code)` would, without the interpreter's
     finalisation where nothing needs it (issue 36).
 
-    Tearing down the interpreter after the kernels are loaded took 0.13-0.14 s of every
-    ``emaphm identify`` on machine G (0.05 s after the imports alone): numba's and llvmlite's
-    objects freed one by one, which serves nothing at the end of a process. So the streams are
-    flushed, the atexit functions run (logging, h5py, dask and any a library registered), then
-    `os._exit`. The ordinary exit stays where something may still need it: another thread that is
-    not a daemon or a child process still alive, or a profiler or tracer attached (whose output is
+    Tearing down the interpreter took 0.13-0.14 s of every ``emaphm identify`` on machine G once
+    the kernels were loaded (0.05 s after the imports alone; timed from the end of `main` to the
+    process's end), which serves nothing at the end of a process. So the atexit functions run
+    (logging, h5py, dask and any a library registered), the streams are flushed, then `os._exit`.
+    The ordinary exit stays where something may still need it: another thread that is not a
+    daemon or a child process still alive, or a profiler or tracer attached (whose output is
     written at the interpreter's exit)."""
     if code is None:
         status = 0
