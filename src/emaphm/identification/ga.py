@@ -37,7 +37,14 @@ from pymoo.operators.crossover.pcx import pcx
 from pymoo.operators.mutation.pm import mut_pm
 from pymoo.operators.repair.bounds_repair import repair_random_init
 
-from .optimizers import BatchProblem, GenerationLog, OnGeneration, OptimizerRun, Stagnation
+from .optimizers import (
+    BatchProblem,
+    GenerationLog,
+    OnGeneration,
+    OptimizerRun,
+    Stagnation,
+    duplicate_distances,
+)
 
 __all__ = ["PCX_ETA", "PCX_ZETA", "Termination", "genetic_algorithm"]
 
@@ -200,9 +207,6 @@ def _mate(
 def _duplicates(X: NDArray[np.float64], other: NDArray[np.float64] | None) -> NDArray[np.bool_]:
     """`optimizers.NumpyDuplicates`' test: rows of X within `DUPLICATE_EPS` of an earlier row of
     X (`other` None) or of any row of `other`."""
-    Y = X if other is None else other
-    D = np.sqrt(np.sum((X[:, None, :] - Y[None, :, :]) ** 2, axis=-1))
-    if other is None:
-        D[np.triu_indices(len(X))] = np.inf
+    D = duplicate_distances(X, other)
     D[np.isnan(D)] = np.inf
     return np.any(D <= DUPLICATE_EPS, axis=1)  # type: ignore[no-any-return]

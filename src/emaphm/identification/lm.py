@@ -48,7 +48,6 @@ the step bounded anyway.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -122,11 +121,7 @@ def levenberg_marquardt_many(
             at += len(X)
         if spare is not None:
             j, d, _ = wanted[0]
-            if d.result is None:
-                d.hold_spare(spare, filled(j, R[at]))
-            else:  # the first trial ended the descent: the spare is not taken
-                d.spared += 1
-                d.result = replace(d.result, spared=d.spared)
+            d.hold_spare(spare, filled(j, R[at]))
         if on_round is not None:
             on_round(sum(d.result is not None for d in descents), len(descents))
 

@@ -8,7 +8,7 @@ runs per round; the method, the secants and the spare trial point are described 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -168,7 +168,12 @@ class Descent:
         return x_spare
 
     def hold_spare(self, x_spare: NDArray[np.float64], r_spare: NDArray[np.float64]) -> None:
-        """Keep a spare trial point's residual for `spared_residuals`."""
+        """Keep a spare trial point's residual for `spared_residuals`; where the trial beside it
+        ended the descent, the spare is only counted (`LmResult.spared`)."""
+        if self.result is not None:
+            self.spared += 1
+            self.result = replace(self.result, spared=self.spared)
+            return
         self.spare = (x_spare, r_spare)
 
     def spared_residuals(self, X: NDArray[np.float64]) -> NDArray[np.float64] | None:

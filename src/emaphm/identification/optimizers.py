@@ -47,6 +47,7 @@ __all__ = [
     "RelativeObjectiveTermination",
     "Stagnation",
     "check_optimizer",
+    "duplicate_distances",
     "minimize_batch",
     "run_pymoo",
 ]
@@ -152,11 +153,18 @@ class NumpyDuplicates(DefaultDuplicateElimination):  # type: ignore[misc]
 
     def calc_dist(self, pop: Any, other: Any = None) -> NDArray[np.float64]:
         X = np.asarray(self.func(pop), dtype=np.float64)
-        Y = X if other is None else np.asarray(self.func(other), dtype=np.float64)
-        D = np.sqrt(np.sum((X[:, None, :] - Y[None, :, :]) ** 2, axis=-1))
-        if other is None:
-            D[np.triu_indices(len(X))] = np.inf  # each pair once, never a member with itself
-        return D
+        return duplicate_distances(X, None if other is None else np.asarray(self.func(other), dtype=np.float64))
+
+
+def duplicate_distances(X: NDArray[np.float64], other: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    """The distances the GA's duplicate check compares with its epsilon (`NumpyDuplicates`,
+    `ga`): of each row of X to each row of `other`, or (`other` None) to each earlier row of X
+    (+inf elsewhere: each pair once, never a row with itself)."""
+    Y = X if other is None else other
+    D = np.sqrt(np.sum((X[:, None, :] - Y[None, :, :]) ** 2, axis=-1))
+    if other is None:
+        D[np.triu_indices(len(X))] = np.inf
+    return D  # type: ignore[no-any-return]
 
 
 def best_value(algorithm: Any) -> float:
