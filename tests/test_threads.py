@@ -95,6 +95,28 @@ def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
     assert out[4] == "1.0"
 
 
+def test_a_kernel_load_fires_no_llvm_lock_events_and_a_compilation_still_does():
+    # kernels/_jit._llvm_lock_events_off: numba's callbacks on llvmlite's lock are off while a
+    # cached kernel loads and back, in their order, afterwards; a compilation still fires them
+    code = (
+        "import numpy as np\n"
+        "from llvmlite.binding import ffi\n"
+        "from emaphm.kernels.transforms import clarke\n"
+        "calls = []\n"
+        "ffi.register_lock_callback(lambda: calls.append(1), lambda: None)\n"
+        "before = list(ffi.lib._lock._cblist)\n"
+        "clarke(np.zeros(4), np.zeros(4), np.zeros(4))\n"
+        "print(len(calls), list(ffi.lib._lock._cblist) == before)\n"
+        "print(clarke.stats.cache_hits and sum(clarke.stats.cache_hits.values()) > 0)\n"
+        "import numba\n"
+        "numba.njit(lambda a: a + 1)(1.0)\n"
+        "print(len(calls) > 0)\n"
+    )
+    _fresh(code)  # a cold cache compiles here (a fresh machine): the second process loads
+    out = _fresh(code)
+    assert out == ["0", "True", "True", "True"], out
+
+
 def test_thread_map_starts_the_costliest_first_and_returns_in_the_items_order():
     import threading
     import time

@@ -309,6 +309,50 @@ def test_import_cmaes_puts_the_blocked_modules_back_when_the_import_fails(monkey
         assert name not in sys.modules  # not left behind as None: importable again
 
 
+def test_import_cmaes_leaves_moocore_unimported_and_pymoos_indicators_working():
+    # the stand-in `cmaes._LazyMoocore`: pymoo's hypervolume imports the real moocore when called
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, numpy as np\n"
+        "from emaphm.identification.cmaes import import_cmaes\n"
+        "import_cmaes()\n"
+        "print('moocore' in sys.modules)\n"
+        "from pymoo.indicators.hv import Hypervolume\n"
+        "print(Hypervolume(ref_point=np.ones(2)).do(np.array([[0.5, 0.5], [0.2, 0.8]])))\n"
+        "import moocore\n"
+        "print(type(moocore).__name__, moocore.hypervolume(np.array([[0.5, 0.5]]), ref=np.ones(2)))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False", "0.31", "module", "0.25"], out
+
+
+def test_the_relative_stop_stops_where_pymoos_objective_space_termination_with_its_delta_does():
+    # optimizers.RelativeObjectiveTermination is built on pymoo's DeltaToleranceTermination with
+    # SingleObjectiveSpaceTermination's _data; the same delta on pymoo's own class stops alike
+    from pymoo.termination.ftol import SingleObjectiveSpaceTermination
+    from pymoo.termination.robust import RobustTermination
+
+    from emaphm.identification.optimizers import RelativeObjectiveTermination
+
+    class Theirs(SingleObjectiveSpaceTermination):
+        _delta = RelativeObjectiveTermination._delta
+
+    rng = np.random.default_rng(5)
+    for trial in range(40):
+        steps = rng.choice([0.0, 1e-4, 5e-4, 2e-3, 0.05], size=30, p=[0.4, 0.2, 0.15, 0.15, 0.1])
+        best = 1.0 - np.cumsum(steps) * (0.5 if trial % 2 else 1.0)
+        if trial % 5 == 0:
+            best[:3] = np.inf  # nothing feasible yet
+        ours, theirs = (RobustTermination(cls(1e-3), period=4) for cls in (RelativeObjectiveTermination, Theirs))
+        for g, f in enumerate(best):
+            feasible = np.isfinite([f, f + 1.0])
+            algorithm = SimpleNamespace(opt=SimpleNamespace(get=lambda key, f=f, feas=feasible: np.array([f, f + 1.0]) if key == "f" else feas))
+            assert ours.update(algorithm) == theirs.update(algorithm), (trial, g)
+            assert ours.has_terminated() == theirs.has_terminated()
+
+
 def test_the_least_squares_polish_evaluates_no_point_twice():
     # its Jacobian starts from the residual scipy has just evaluated at that point, and scipy's
     # second look at the start reuses the first: every row evaluated is a new point

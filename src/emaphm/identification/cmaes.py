@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
 import sys
 import threading
+import types
 import warnings
 from typing import Any
 
@@ -22,8 +24,13 @@ def import_cmaes() -> Any:
     BENCHMARKS.md. While `cma` is first imported, those of them not loaded yet are made
     unimportable (None in ``sys.modules``, which `cma` catches), then put back: anyone can import
     them afterwards, but in this process `cma`'s own plots stay unavailable and its surrogate
-    models use its fallback. Only when no other Python thread runs (another thread could import
-    them meanwhile): the CLI calls this before its progress bar starts a thread.
+    models use its fallback. pymoo's CMAES imports pymoo's hypervolume (through its default
+    termination), which imports `moocore` with its data sets, ``urllib.request`` and
+    ``platformdirs`` (12 ms of every diagnosis on machine G, issue 36) for multi-objective
+    indicators: while pymoo is imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions
+    import the real one when first called, so pymoo's indicators still work. Only when no other
+    Python thread runs (another thread could import them meanwhile): the CLI calls this before
+    its progress bar starts a thread.
     """
     if "cma" in sys.modules or threading.active_count() > 1:
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
@@ -32,6 +39,9 @@ def import_cmaes() -> Any:
     blocked = [name for name in CMA_UNUSED_IMPORTS if name not in sys.modules]
     for name in blocked:
         sys.modules[name] = None  # type: ignore[assignment]
+    stand_in = None if "moocore" in sys.modules else _LazyMoocore("moocore")
+    if stand_in is not None:
+        sys.modules["moocore"] = stand_in
     # cma's "Could not import matplotlib.pyplot, therefore ``cma.plot()`` etc. is not available"
     warnings.filterwarnings("ignore", message="Could not import matplotlib", category=UserWarning)
     try:
@@ -40,7 +50,24 @@ def import_cmaes() -> Any:
         for name in blocked:
             if name in sys.modules and sys.modules[name] is None:
                 del sys.modules[name]
+        if stand_in is not None and sys.modules.get("moocore") is stand_in:
+            del sys.modules["moocore"]
     return CMAES
+
+
+class _LazyMoocore(types.ModuleType):
+    """A stand-in for `moocore` while pymoo is imported (`import_cmaes`): ``from moocore import f``
+    gives a function that imports the real `moocore` (no longer stood in for) and calls its f."""
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+
+        def forward(*args: Any, **kwargs: Any) -> Any:
+            return getattr(importlib.import_module("moocore"), name)(*args, **kwargs)
+
+        forward.__name__ = forward.__qualname__ = name
+        return forward
 
 
 # what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)

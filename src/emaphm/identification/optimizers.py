@@ -32,7 +32,7 @@ from pymoo.core.duplicate import DefaultDuplicateElimination
 from pymoo.core.problem import Problem
 from pymoo.core.termination import TerminateIfAny, Termination
 from pymoo.optimize import minimize
-from pymoo.termination.ftol import SingleObjectiveSpaceTermination
+from pymoo.termination.delta import DeltaToleranceTermination
 from pymoo.termination.max_gen import MaximumGenerationTermination
 from pymoo.termination.robust import RobustTermination
 
@@ -91,9 +91,28 @@ class Stagnation:
         )
 
 
-class RelativeObjectiveTermination(SingleObjectiveSpaceTermination):  # type: ignore[misc]
+class RelativeObjectiveTermination(DeltaToleranceTermination):  # type: ignore[misc]
     """pymoo's `SingleObjectiveSpaceTermination` with a relative tolerance: the improvement of the
-    best value on the reference, divided by |reference| (pymoo divides by nothing)."""
+    best value on the reference, divided by |reference| (pymoo divides by nothing).
+
+    Built on pymoo's `DeltaToleranceTermination` with `SingleObjectiveSpaceTermination`'s `_data`
+    (the best feasible value, inf when none) instead of subclassing it: its module
+    (``pymoo.termination.ftol``) imports pymoo's hypervolume and with it `moocore` (its data sets,
+    ``urllib.request``, ``platformdirs``), about 15 ms of every diagnosis's start for a
+    multi-objective indicator (issue 36). `tests/identification/test_optimizers.py` checks both
+    stop at the same generation.
+    """
+
+    def __init__(self, tol: float = 1e-6, only_feas: bool = True, **kwargs: Any) -> None:
+        super().__init__(tol, **kwargs)
+        self.only_feas = only_feas
+
+    def _data(self, algorithm: Any) -> float:  # pymoo 0.6.2's SingleObjectiveSpaceTermination._data
+        opt = algorithm.opt
+        f = opt.get("f")
+        if self.only_feas:
+            f = f[opt.get("feas")]
+        return float(f.min()) if len(f) > 0 else np.inf
 
     def _delta(self, prev: float, current: float) -> float:
         if not (np.isfinite(prev) and np.isfinite(current)):

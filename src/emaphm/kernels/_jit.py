@@ -19,18 +19,22 @@ of a diagnosis's start, issue 36), which only *compiling* needs; loading machine
 runtime (NRT) initialised. emaphm's kernels therefore load through `QuickLoadCache`, which
 initialises the runtime and nothing else; a compilation still refreshes the context itself
 (numba's `CompilerBase.__init__`), so a cache miss, or any other jitted function, compiles as
-before. Where numba's cache lacks the two methods it builds on, the kernels keep numba's own.
+before. Where numba's cache lacks the two methods it builds on, the kernels keep numba's own. A
+load also runs without numba's events on LLVM's lock (`_llvm_lock_events_off`), which time a
+compilation and cost a load 10-15 % of its time.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
+from llvmlite.binding import ffi
 from numba import config, njit
 from numba.core import caching
 from numba.core.runtime import rtsys
@@ -108,12 +112,37 @@ CACHE_ENABLED = _writable(kernel_cache_dir() / __name__.split(".", 1)[0])
 
 
 class QuickLoadCache(caching.FunctionCache):  # type: ignore[misc]
-    """numba's function cache, loading without the target context's refresh (module docstring)."""
+    """numba's function cache, loading without the target context's refresh and without numba's
+    events on LLVM's lock (module docstring)."""
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
-        rtsys.initialize(target_context)  # what loaded machine code needs of the context
-        with self._guard_against_spurious_io_errors():
-            return self._load_overload(sig, target_context)
+        with _llvm_lock_events_off():
+            rtsys.initialize(target_context)  # what loaded machine code needs of the context
+            with self._guard_against_spurious_io_errors():
+                return self._load_overload(sig, target_context)
+
+
+@contextlib.contextmanager
+def _llvm_lock_events_off() -> Iterator[None]:
+    """Without the callbacks on llvmlite's lock inside the block (`QuickLoadCache`'s loads).
+
+    numba registers two (``numba.core.base._initialize_llvm_lock_event``) that broadcast a
+    "numba:llvm_lock" event before and after every one of llvmlite's calls, so that a compilation
+    can time its share of LLVM's lock; loading one cached kernel makes about 300 such calls, and
+    the events were 10-15 % of the loads' time (3 515 calls, about 15 ms of every diagnosis's
+    start on machine G, issue 36). A load times nothing, and it runs under numba's compiler lock,
+    so no compilation misses its events (the runtime's first initialisation, which compiles
+    NRT's functions, runs inside the block too). The callbacks are put back afterwards in their order;
+    where llvmlite keeps them elsewhere than ``ffi.lib._lock._cblist``, nothing changes."""
+    lock = getattr(getattr(ffi, "lib", None), "_lock", None)
+    callbacks = list(getattr(lock, "_cblist", ()))
+    for acquire, release in callbacks:
+        ffi.unregister_lock_callback(acquire, release)
+    try:
+        yield
+    finally:
+        for acquire, release in callbacks:
+            ffi.register_lock_callback(acquire, release)
 
 
 QUICK_LOAD = all(
