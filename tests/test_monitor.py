@@ -69,6 +69,26 @@ def test_the_paper_monitor_is_the_same_model_without_its_loop_surrogate():
     )
 
 
+def test_the_monitors_rows_are_monitor_rows_and_follow_a_replaced_calibration():
+    # MonitorEma.rows keeps the fields the faults do not set in one row per actuator and calibration
+    from emaphm.models.lf import monitor_rows
+
+    rng = np.random.default_rng(3)
+    monitor, paper = MonitorEma(), MonitorEma(monitor="paper")
+
+    def rows_of(m, K):
+        cal = m.calibration
+        return monitor_rows(K, m.params, [cal.coefficients], cal.n_lf, cal.monitor)
+
+    for m in range(1, 12):
+        K = rng.uniform(size=(m, 8))
+        assert np.array_equal(monitor.rows(K), rows_of(monitor, K))
+    K = rng.uniform(size=(3, 8))
+    before = monitor.rows(K)
+    monitor.calibration = paper.calibration
+    assert np.array_equal(monitor.rows(K), rows_of(paper, K)) and not np.array_equal(monitor.rows(K), before)
+
+
 def test_a_monitor_choice_that_does_not_match_the_calibration_is_refused(tmp_path):
     with pytest.raises(InputError, match="unknown monitor"):
         MonitorEma(monitor="three-phase")

@@ -204,3 +204,22 @@ def test_a_spare_goes_only_with_a_lone_trial_point():
     both = next(i for i, (a, b) in enumerate(zip(sizes[True], sizes[False], strict=False)) if a != b)
     assert sizes[True][:both] == sizes[False][:both]
     assert sizes[True][both] == 2 and sizes[False][both] == 1
+
+
+def test_gram_is_einsums_product_to_the_bit_on_random_shapes_and_views():
+    # lm_descent.gram takes each row of JᵀJ from its diagonal on and mirrors it; einsum's own
+    # product is the reference, bit for bit (a Jacobian's columns are differences over ~1e-2)
+    from emaphm.identification.lm_descent import gram
+
+    rng = np.random.default_rng(36)
+    for trial in range(600):
+        n, m = int(rng.integers(1, 11)), int(rng.integers(1, 12_000))
+        Jt = rng.standard_normal((n, m)) * 10 ** rng.uniform(-6, 6, size=(n, 1))
+        if trial % 3 == 0:
+            Jt = (rng.standard_normal((n, m)) - rng.standard_normal((1, m))) / 1e-2
+        if trial % 4 == 0:
+            Jt = Jt[:, : max(1, m // 2)]  # rows with a stride longer than their length
+        expected = np.einsum("ik,jk->ij", Jt, Jt)
+        assert np.array_equal(gram(Jt), expected), (n, m)
+    one_row = rng.standard_normal((1, 5))
+    assert gram(one_row).shape == (1, 1) and np.array_equal(gram(one_row), np.einsum("ik,jk->ij", one_row, one_row))

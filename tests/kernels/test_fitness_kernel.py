@@ -138,7 +138,7 @@ def population(n_rows=23, duration=0.2):
 def run_kernel(theta_cmd, rows, fitness):
     out = np.full(rows.shape[0], -1.0)
     f = fitness
-    fitness_lf_many(theta_cmd, rows, f.sos, f.zi, f.padlen, f.comparison.reference, f.weights, out)
+    fitness_lf_many(theta_cmd, rows, f.sos, f.zi, f.padlen, f.comparison.reference, f.weights, out, numba.get_num_threads())
     return out
 
 
@@ -236,7 +236,7 @@ def test_a_diverged_row_gets_non_finite_residuals_and_the_others_do_not_change()
     _, theta_cmd = lf.sample_grid(0.2)
     keep = np.flatnonzero(fitness.weights > 0)
     residuals_lf_many(theta_cmd, broken, fitness.sos, fitness.zi, fitness.padlen, keep,
-                      fitness.comparison.reference[keep], np.sqrt(fitness.weights[keep]), out)  # fmt: skip
+                      fitness.comparison.reference[keep], np.sqrt(fitness.weights[keep]), out, numba.get_num_threads())  # fmt: skip
     assert np.all(np.isfinite(clean)) and np.isnan(out[4]).all()
     np.testing.assert_array_equal(out[:4], clean[:4])
     with pytest.raises(ValueError, match="500"):

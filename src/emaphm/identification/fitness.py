@@ -23,6 +23,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import get_num_threads
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
@@ -96,14 +97,26 @@ class Fitness:
         self._check_grid(len(theta_cmd))
         keep, root_w, reference = self.weighed()
         out = np.empty((rows.shape[0], len(keep)))
-        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, reference, root_w, out)
+        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, reference, root_w, out, get_num_threads())
         return out
 
     def weighed(self) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
         """The samples eq. (3) weighs (w > 0), their √w and the reference there: the residual
-        vector's layout (`residuals_of_monitor`, r = √w·(I_ref − I_LF) on these samples)."""
-        keep = np.flatnonzero(self.weights > 0)
-        return keep, np.sqrt(self.weights[keep]), self.comparison.reference[keep]
+        vector's layout (`residuals_of_monitor`, r = √w·(I_ref − I_LF) on these samples).
+
+        Kept (read-only) for the weights and reference it was taken from, which a least-squares
+        descent asks for at every round (a few hundred times a diagnosis, 40 µs each: issue 36);
+        a `shifted` copy, with its own reference, takes its own."""
+        weights, reference = self.weights, self.comparison.reference
+        kept = getattr(self, "_weighed", None)
+        if kept is not None and kept[0] is weights and kept[1] is reference:
+            return kept[2]  # type: ignore[no-any-return]
+        keep = np.flatnonzero(weights > 0)
+        out = (keep, np.sqrt(weights[keep]), reference[keep])
+        for array in out:
+            array.setflags(write=False)
+        self._weighed = (weights, reference, out)
+        return out
 
     def _check_grid(self, n: int) -> None:
         ref = self.comparison.reference
@@ -131,5 +144,5 @@ class Fitness:
         ref = self.comparison.reference
         self._check_grid(len(theta_cmd))
         out = np.empty(rows.shape[0])
-        fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out)
+        fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out, get_num_threads())
         return out

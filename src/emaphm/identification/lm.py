@@ -93,7 +93,9 @@ def levenberg_marquardt_many(
                 for x0, r0 in zip(X0, R0, strict=True)]  # fmt: skip
 
     def filled(j: int, part: NDArray[np.float64]) -> NDArray[np.float64]:
-        return part if fill is None else np.where(np.isfinite(part), part, fill[j])
+        if fill is None or np.isfinite(part).all():  # nearly always: no copy of the rows
+            return part
+        return np.where(np.isfinite(part), part, fill[j])
 
     while True:
         wanted = []

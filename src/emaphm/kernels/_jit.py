@@ -78,6 +78,7 @@ class KernelCacheLocator(caching._CacheLocator):  # type: ignore[misc]
     """numba cache locator for the files in this folder: stamped by the hash of all of them."""
 
     def __init__(self, py_func: Any, py_file: str) -> None:
+        self._py_file = py_file  # where numba's "Cannot cache" warning points (its locators' attribute)
         self._lineno = py_func.__code__.co_firstlineno
         # one sub-folder per importing package name: numba's index records types by module
         # name, so a renamed copy of the package (same sources) must not share its entries

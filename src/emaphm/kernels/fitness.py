@@ -1,6 +1,7 @@
 """The identification fitness fused into the LF population kernel (paper eq. 3, DESIGN §5).
 
-`fitness_lf_many` runs, per parameter row and in parallel (prange over pairs of rows), what the
+`fitness_lf_many` runs, per parameter row and in parallel (pairs of rows and single rows shared
+among the threads, `batches.batch_plan`), what the
 Python path does in three steps (`monitor.simulate_lf_many`, `signals.lowpass`, `Fitness`):
 
 1. the LF simulation (`monitor.simulate_lf`) into a per-row buffer;
@@ -33,6 +34,7 @@ import numpy as np
 from numba import prange
 
 from ._jit import jit
+from .batches import batch_plan
 from .monitor import N_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
@@ -257,53 +259,54 @@ def simulate_pair(theta_cmd, prm, r, pair, pad):  # type: ignore[no-untyped-def]
 
 
 @jit(parallel=True)
-def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out):  # type: ignore[no-untyped-def]
+def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads):  # type: ignore[no-untyped-def]
     """eq. (3) of one LF run per row of `prm` (shape (n_runs, N_FIELDS)) into out (n_runs,), in parallel.
 
     = Σ weights·(ref − sosfiltfilt(sos, simulate_lf(row)))² per row; ref and weights have the
     length of theta_cmd; zi = sosfilt_zi(sos); pad = sosfiltfilt's default padlen. The rows go in
-    pairs (rows 2q and 2q + 1 on one thread) whose filters run interleaved; with an odd number of
-    rows the last one is paired with a zero signal.
+    pairs (rows 2q and 2q + 1 on one thread) whose filters run interleaved, some rows alone where
+    that shares the batch better among the threads (`batches.batch_plan`); a row alone is
+    filtered beside a zero signal. `n_threads`: the threads numba runs it on
+    (``numba.get_num_threads()``; a kernel that asks numba itself cannot be cached).
     """
-    n_runs = prm.shape[0]
-    for q in prange((n_runs + 1) // 2):
-        r = 2 * q
-        pair = r + 1 < n_runs
-        buf = simulate_pair(theta_cmd, prm, r, pair, pad)
-        fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
-        out[r] = fit_0
-        if pair:
-            out[r + 1] = fit_1
+    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
+    for t in prange(n_threads):
+        for task in range(owner.shape[0]):
+            if owner[task] != t:
+                continue
+            pair = task < n_pairs
+            r = 2 * task if pair else n_pairs + task
+            buf = simulate_pair(theta_cmd, prm, r, pair, pad)
+            fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
+            out[r] = fit_0
+            if pair:
+                out[r + 1] = fit_1
 
 
 @jit(parallel=True)
-def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out):  # type: ignore[no-untyped-def]
+def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads):  # type: ignore[no-untyped-def]
     """eq. (3)'s residual vector of one LF run per row of `prm` into out (n_runs, len(keep)), in
     parallel: out[r] = root_w·(ref_keep − sosfiltfilt(sos, simulate_lf(row))[keep]).
 
     The least squares' view of `fitness_lf_many` (Σ out[r]² is its eq. 3 to rounding): the same
-    runs and filter, rows in interleaved pairs, the same numbers as filtering the currents of
+    runs and filter, rows shared among the threads alike (`batches.batch_plan`: two rows on two
+    threads run one on each, so a least-squares descent's trial point and its spare,
+    `identification.lm`, cost one row's time), the same numbers as filtering the currents of
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
-    LF current is not finite gets NaN residuals.
-
-    Two rows run one on each thread instead (a pair would leave the other thread idle): a
-    least-squares descent's trial point and its spare (`identification.lm`) cost one row's time.
+    LF current is not finite gets NaN residuals. `n_threads` as in `fitness_lf_many`.
     """
-    n_runs = prm.shape[0]
-    if n_runs == 2:
-        for r in prange(2):
-            buf = simulate_pair(theta_cmd, prm, r, False, pad)
+    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
+    for t in prange(n_threads):
+        for task in range(owner.shape[0]):
+            if owner[task] != t:
+                continue
+            pair = task < n_pairs
+            r = 2 * task if pair else n_pairs + task
+            buf = simulate_pair(theta_cmd, prm, r, pair, pad)
             sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
             kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
-        return
-    for q in prange((n_runs + 1) // 2):
-        r = 2 * q
-        pair = r + 1 < n_runs
-        buf = simulate_pair(theta_cmd, prm, r, pair, pad)
-        sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-        kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
-        if pair:
-            kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
+            if pair:
+                kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
 
 
 @jit
