@@ -108,6 +108,23 @@ def test_laplace_intervals_of_a_linear_gaussian_oracle_cover_90_percent():
     assert np.all(inside_naive / draws < 0.6), inside_naive / draws
 
 
+def test_laplace_on_the_monitor_model_gives_what_its_currents_give_through_simulate_many():
+    # laplace._residuals: the fused kernel for the monitor model, simulate_many for any other
+    monitor = MonitorEma()
+    truth = np.array([0.2, 0.5, 0.0, 0.45, 0.04, 0.1, 0.28, 0.5])
+    trace = monitor.simulate(truth, noise=True, seed=2, duration=0.3)
+    fit = Fitness(Comparison.from_signal(trace.t, trace.i_q, monitor.params.controller.f_s))
+
+    class Currents:  # the monitor as any model: its currents only
+        def simulate_many(self, K, *, duration=None, check=True):
+            return monitor.simulate_many(K, duration=duration, check=check)
+
+    fused, plain = laplace(fit, monitor, truth, duration=0.3), laplace(fit, Currents(), truth, duration=0.3)  # type: ignore[arg-type]
+    for name in ("std", "ci90_low", "ci90_high", "raw_std", "cov_u"):
+        np.testing.assert_array_equal(getattr(fused, name), getattr(plain, name))
+    assert fused.details["s2"] == plain.details["s2"]
+
+
 def test_an_estimate_at_a_bound_gets_a_one_sided_interval_that_holds_the_bound():
     k = np.array([0.0, 0.3, 0.002, 0.4, 0.999, 0.1, 0.3, 0.5])
     _std, lo, hi, flags = intervals(k, np.full(8, 0.01))

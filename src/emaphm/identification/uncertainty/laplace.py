@@ -140,8 +140,6 @@ def laplace(
     u0 = to_cartesian(k_hat)[0]
     factors = factors if factors is not None else Factors.identity()
     keep = objective.weights > 0
-    sw = np.sqrt(objective.weights[keep])
-    ref = objective.comparison.reference[keep]
     n = int(keep.sum())
     rows = [u0]
     spans = []
@@ -156,12 +154,11 @@ def laplace(
             rows += [up, down]
             spans.append(up[j] - down[j])
     K = np.clip(to_faults(np.array(rows)), 0.0, 1.0)
-    currents = monitor.simulate_many(K, duration=duration, check=False)
-    R = sw * (ref - objective.comparison.filtered(currents)[:, keep])
+    R = _residuals(objective, monitor, K, duration)
     r0 = R[0]
     if not np.all(np.isfinite(r0)):
         raise InputError("the monitor diverges at the estimate: no uncertainty can be given")
-    ssr = float(r0 @ r0)
+    ssr = float(np.sum(r0 * r0))  # numpy's pairwise sum: the same whatever the rows' layout and BLAS
     s2 = ssr / max(n - N_PARAMS, 1)
     tau = integrated_time(r0)
     covs, sds = [], []
@@ -202,6 +199,20 @@ def laplace(
         "constants_std": None if constants_cov is None else [round(float(a), 6) for a in added],
     }
     return Uncertainty("laplace", std, lo, hi, corr, flags, raw, len(rows), details, cov_u)
+
+
+def _residuals(objective: Fitness, monitor: MonitorEma, K: NDArray[np.float64], duration: float | None) -> NDArray[np.float64]:
+    """√w·(I_ref − F(I_LF)) of the rows K on the samples eq. 3 weighs: for the monitor model the
+    fused kernel (`Fitness.residuals_of_monitor`, one call, the numbers of filtering its currents
+    and taking the residual in numpy: test_fitness_kernel), for another model (a test's oracle)
+    from its ``simulate_many``."""
+    from ...models import MonitorEma
+
+    if isinstance(monitor, MonitorEma):
+        return objective.residuals_of_monitor(monitor, K, duration=duration)
+    keep = objective.weights > 0
+    currents = monitor.simulate_many(K, duration=duration, check=False)
+    return np.sqrt(objective.weights[keep]) * (objective.comparison.reference[keep] - objective.comparison.filtered(currents)[:, keep])  # type: ignore[no-any-return]
 
 
 def _widened(calibrated: NDArray[np.float64], objective: Fitness, monitor: MonitorEma, k_hat: NDArray[np.float64],
