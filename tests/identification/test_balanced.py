@@ -13,7 +13,13 @@ from emaphm.actuator import resolve_params
 from emaphm.faults import FAULT_NAMES, HEALTHY, SHORTS
 from emaphm.identification.uncertainty import Uncertainty
 from emaphm.identification.uncertainty.balanced import (
-    BAND, CONSISTENT, SLOPE, allowance, discounted, doubts, widen,
+    BAND,
+    CONSISTENT,
+    SLOPE,
+    allowance,
+    discounted,
+    doubts,
+    widen,
 )  # fmt: skip
 from emaphm.models import HighFidelityEma
 

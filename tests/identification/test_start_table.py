@@ -150,7 +150,7 @@ def test_a_recording_of_the_chirp_shares_the_chirps_table_and_another_command_ha
     assert start_table.uses_table(_context(trace, optimizer="de")) is None
     steps = sim(K, command=Steps(), ideal=False)
     steps_ctx = _context(steps, Steps())
-    t, theta = steps_ctx.monitor.sample_grid(steps_ctx.duration)
+    _, theta = steps_ctx.monitor.sample_grid(steps_ctx.duration)
     np.testing.assert_array_equal(start_table.uses_table(steps_ctx), theta)  # a built-in command's own
 
 

@@ -1,18 +1,39 @@
-"""pymoo's CMA-ES (the `cma` package), imported lean: the search's "cmaes" and the polish (`polish`)."""
+"""The CMA-ES (the `cma` package, as pymoo 0.6.2 drives it), imported lean: the polishes
+(`cmaes_minimize`, on arrays) and the search's "cmaes" (pymoo's `CMAES`, `cmaes`).
+
+`cmaes_minimize` is ``minimize_batch(problem, cmaes(x0, σ, λ, G), G, ...)`` without pymoo's
+object model: pymoo's CMAES evaluates x0 as its first generation, then sends each generation's
+values to pymoo's own generator around `cma` (``pymoo.vendor.vendor_cmaes.my_fmin``, in the box
+normalised to [0, 1]) and keeps the best point seen; its termination, generation log and optimum
+are replayed on arrays (`ga.Termination`, `GenerationLog`). pymoo's `Algorithm`, `Population`
+and display took about 10 ms of every diagnosis's imports and a few ms of bookkeeping per polish
+(issue 36). Tested against pymoo's CMAES run by `minimize_batch` (tests/identification/
+test_cmaes.py): the same point, value, evaluations and history to the bit.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import sys
 import threading
 import types
 import warnings
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CMA_UNUSED_IMPORTS", "cmaes", "import_cmaes"]
+from .ga import Termination
+from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
+
+__all__ = ["CMA_UNUSED_IMPORTS", "cmaes", "cmaes_minimize", "import_cmaes"]
+
+# what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)
+CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
+# pymoo's CMAES options besides the population, the generations, the bounds and the seed
+PYMOO_CMA_OPTIONS: dict[str, Any] = {"verbose": -9, "verb_log": 0, "maxfevals": np.inf, "tolfun": 1e-11, "tolx": 1e-11}
 
 
 def import_cmaes() -> Any:
@@ -26,33 +47,47 @@ def import_cmaes() -> Any:
     them afterwards, but in this process `cma`'s own plots stay unavailable and its surrogate
     models use its fallback. pymoo's CMAES imports pymoo's hypervolume (through its default
     termination), which imports `moocore` with its data sets, ``urllib.request`` and
-    ``platformdirs`` (12 ms of every diagnosis on machine G, issue 36) for multi-objective
-    indicators: while pymoo is imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions
-    import the real one when first called, so pymoo's indicators still work. Only when no other
-    Python thread runs (another thread could import them meanwhile): the CLI calls this before
-    its progress bar starts a thread.
+    ``platformdirs`` (12 ms on machine G, issue 36) for multi-objective indicators: while pymoo is
+    imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions import the real one when
+    first called, so pymoo's indicators still work. Only when no other Python thread runs
+    (another thread could import them meanwhile): the CLI calls this before its progress bar
+    starts a thread.
     """
-    if "cma" in sys.modules or threading.active_count() > 1:
+    with _lean_imports(moocore=True):
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+    return CMAES
 
-        return CMAES
+
+def _my_fmin() -> Any:
+    """pymoo's generator around `cma` (``pymoo.vendor.vendor_cmaes.my_fmin``), imported lean."""
+    with _lean_imports(moocore=False):
+        from pymoo.vendor.vendor_cmaes import my_fmin
+    return my_fmin
+
+
+@contextlib.contextmanager
+def _lean_imports(*, moocore: bool) -> Iterator[None]:
+    """`CMA_UNUSED_IMPORTS` blocked and (with `moocore`) `moocore` stood in for while `cma` is
+    first imported (`import_cmaes`); nothing once it is, or while another thread runs."""
+    if "cma" in sys.modules or threading.active_count() > 1:
+        yield
+        return
     blocked = [name for name in CMA_UNUSED_IMPORTS if name not in sys.modules]
     for name in blocked:
         sys.modules[name] = None  # type: ignore[assignment]
-    stand_in = None if "moocore" in sys.modules else _LazyMoocore("moocore")
+    stand_in = _LazyMoocore("moocore") if moocore and "moocore" not in sys.modules else None
     if stand_in is not None:
         sys.modules["moocore"] = stand_in
     # cma's "Could not import matplotlib.pyplot, therefore ``cma.plot()`` etc. is not available"
     warnings.filterwarnings("ignore", message="Could not import matplotlib", category=UserWarning)
     try:
-        from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+        yield
     finally:
         for name in blocked:
             if name in sys.modules and sys.modules[name] is None:
                 del sys.modules[name]
         if stand_in is not None and sys.modules.get("moocore") is stand_in:
             del sys.modules["moocore"]
-    return CMAES
 
 
 class _LazyMoocore(types.ModuleType):
@@ -70,12 +105,61 @@ class _LazyMoocore(types.ModuleType):
         return forward
 
 
-# what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)
-CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
-
-
 def cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int) -> Any:
     CMAES = import_cmaes()
     # pymoo passes the generation budget on to the `cma` package only when the termination is a
     # bare MaximumGenerationTermination; give it explicitly, as it is combined with the early stop
     return CMAES(x0=x0, sigma=sigma, popsize=pop_size, restarts=0, maxiter=generations)
+
+
+def cmaes_minimize(
+    problem: BatchProblem,
+    x0: NDArray[np.float64],
+    sigma: float,
+    pop_size: int,
+    generations: int,
+    *,
+    seed: int,
+    stagnation: Stagnation,
+    on_generation: OnGeneration | None = None,
+) -> tuple[NDArray[np.float64], float, list[float]]:
+    """The CMA-ES from x0 with step `sigma` (in the box normalised to [0, 1]) and population
+    `pop_size` on `problem` for at most `generations` (x0's evaluation the first; fewer when
+    `stagnation` stops it or `cma` does): the best point (clipped to the box), its value and the
+    best value per generation, as ``minimize_batch(problem, cmaes(...), generations, ...)`` gives
+    them (the module docstring)."""
+    xl, xu = problem.xl, problem.xu
+    span = xu - xl
+    x_best = np.atleast_2d(np.asarray(x0, dtype=np.float64))  # pymoo's first population: x0
+    f_best = float(problem.evaluate_batch(x_best)[0])
+    termination, log = Termination(generations, stagnation), GenerationLog(generations, on_generation)
+    options = {**PYMOO_CMA_OPTIONS, "popsize": pop_size, "maxiter": generations,
+               "bounds": [np.zeros_like(xl), np.ones_like(xu)], "seed": seed}  # fmt: skip
+    es = _my_fmin()(
+        (x_best[0] - xl) / span, sigma, options=options, parallel_objective=True, restarts=0,
+        restart_from_best="False", incpopsize=2, eval_initial_x=False, noise_handler=None,
+        noise_change_sigma_exponent=1, noise_kappa_exponent=0, bipop=False,
+        random_state=np.random.default_rng(seed),
+    )  # fmt: skip
+    asked = next(es)
+    generation = 1
+    termination.update(generation, f_best)
+    log.record(generation, f_best)
+    while not termination.done:
+        generation += 1
+        many = np.ndim(asked) > 1  # the final mean comes alone
+        X = xl + np.atleast_2d(np.array(asked)) * span
+        F = problem.evaluate_batch(X)
+        i = int(np.argmin(F))
+        if F[i] < f_best:  # pymoo's optimum: the first of the lowest, the older one on a tie
+            x_best, f_best = X[i : i + 1], float(F[i])
+        values = F.tolist()
+        try:
+            asked = es.send(values if many else values[0])
+        except Exception:  # pymoo's CMAES ends on any error of the generator (its end: StopIteration)
+            asked = None
+        if asked is None:
+            termination.forced = True
+        termination.update(generation, f_best)
+        log.record(generation, f_best)
+    return np.clip(x_best[0], xl, xu), f_best, log.history

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import limits
-from .cmaes import cmaes
+from .cmaes import cmaes_minimize
 from .context import Context
 from .descents import candidates, diverged_fill, lm_polish_many
 from .optimizers import (
@@ -27,7 +27,6 @@ from .optimizers import (
     OptimizerRun,
     Residuals,
     Stagnation,
-    minimize_batch,
 )
 from .preconditioned import preconditioned_polish
 from .problem import recentre_phase
@@ -63,8 +62,8 @@ def polish(
     pop_size, generations = limits.POLISH_BUDGET if budget is None else budget
     stop = stagnation if stagnation is not None else Stagnation(patience=limits.POLISH_PATIENCE)
     problem = BatchProblem(evaluate, np.zeros(n_var), np.ones(n_var))
-    x, f, history = minimize_batch(
-        problem, cmaes(np.clip(start.x, 0.0, 1.0), sigma, pop_size, generations), generations,
+    x, f, history = cmaes_minimize(
+        problem, np.clip(start.x, 0.0, 1.0), sigma, pop_size, generations,
         seed=seed, stagnation=stop, on_generation=on_generation,
     )  # fmt: skip
     if not f < start.f:

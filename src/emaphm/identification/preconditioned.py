@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import limits
-from .cmaes import cmaes
+from .cmaes import cmaes_minimize
 from .descents import lm_polish
 from .lm import forward_probes
 from .optimizers import (
@@ -41,7 +41,6 @@ from .optimizers import (
     OptimizerRun,
     Residuals,
     Stagnation,
-    minimize_batch,
 )
 
 __all__ = ["preconditioned_polish", "whitening"]
@@ -119,8 +118,8 @@ def preconditioned_polish(
     # works in y normalised to [0, 1], where a step of 1 in y is 1 / (2·Y_BOUND)
     bound = np.full(len(x0), Y_BOUND)
     problem = BatchProblem(in_y, -bound, bound)
-    y, f, history = minimize_batch(
-        problem, cmaes(np.zeros(len(x0)), 0.5 / Y_BOUND, pop_size, generations), generations, seed=seed,
+    y, f, history = cmaes_minimize(
+        problem, np.zeros(len(x0)), 0.5 / Y_BOUND, pop_size, generations, seed=seed,
         stagnation=Stagnation(patience=limits.PRECONDITIONED["patience"]), on_generation=on_generation,
     )  # fmt: skip
     evaluations += problem.evaluations

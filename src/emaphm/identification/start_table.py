@@ -223,5 +223,5 @@ def first_population(
     source = context if context.table_monitor is None else replace(context, monitor=context.table_monitor)
     table, built = start_table(source, theta_cmd, on_progress)
     X = table.ranked(context.reference.reference, context.objective.weights, pop_size)
-    return X, {"table": table.key[:16], "table_rows": int(len(table.X)), "table_built": built}
+    return X, {"table": table.key[:16], "table_rows": len(table.X), "table_built": built}
 
