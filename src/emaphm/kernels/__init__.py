@@ -8,5 +8,6 @@ Layout (the block diagram): `controller` (ACE position PID), `pmsm_abc` (hystere
 three-phase stator), `mechanics` (gearbox, friction, backlash, end-stops), `sensors` (ADC),
 `transforms` (Clarke–Park), `hf_twin` (the one fixed-step loop of the high-fidelity twin),
 `monitor` (the low-fidelity monitor's loop and its population twin), `fitness` (eq. 3 fused with
-the monitor's population run and the comparison filter); `_jit` is the one njit helper.
+the monitor's population run and the comparison filter), `batches` (how a population's rows are
+shared among the threads); `_jit` is the one njit helper.
 """
