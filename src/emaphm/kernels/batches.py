@@ -58,3 +58,11 @@ def batch_plan(n_runs, n_threads):  # type: ignore[no-untyped-def]
             best_pairs, best_span = n_pairs, span
             best_owner[:] = trial
     return best_owner[: n_runs - best_pairs], best_pairs
+
+
+@jit(inline=True)
+def planned_task(task, n_pairs):  # type: ignore[no-untyped-def]
+    """Task `task` of a `batch_plan` with `n_pairs` pairs: (its first row, whether it is a pair)."""
+    pair = task < n_pairs
+    return (2 * task if pair else n_pairs + task), pair
+

@@ -34,7 +34,7 @@ import numpy as np
 from numba import prange
 
 from ._jit import jit
-from .batches import batch_plan
+from .batches import batch_plan, planned_task
 from .monitor import N_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
@@ -272,15 +272,13 @@ def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads):
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
     for t in prange(n_threads):
         for task in range(owner.shape[0]):
-            if owner[task] != t:
-                continue
-            pair = task < n_pairs
-            r = 2 * task if pair else n_pairs + task
-            buf = simulate_pair(theta_cmd, prm, r, pair, pad)
-            fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
-            out[r] = fit_0
-            if pair:
-                out[r + 1] = fit_1
+            if owner[task] == t:
+                r, pair = planned_task(task, n_pairs)
+                buf = simulate_pair(theta_cmd, prm, r, pair, pad)
+                fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
+                out[r] = fit_0
+                if pair:
+                    out[r + 1] = fit_1
 
 
 @jit(parallel=True)
@@ -298,15 +296,13 @@ def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out,
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
     for t in prange(n_threads):
         for task in range(owner.shape[0]):
-            if owner[task] != t:
-                continue
-            pair = task < n_pairs
-            r = 2 * task if pair else n_pairs + task
-            buf = simulate_pair(theta_cmd, prm, r, pair, pad)
-            sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-            kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
-            if pair:
-                kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
+            if owner[task] == t:
+                r, pair = planned_task(task, n_pairs)
+                buf = simulate_pair(theta_cmd, prm, r, pair, pad)
+                sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+                kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
+                if pair:
+                    kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
 
 
 @jit
