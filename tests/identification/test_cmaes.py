@@ -75,3 +75,17 @@ def test_cma_stopping_itself_ends_with_its_mean_as_pymoo_does():
     (_, _, ea, ha, _), (_, _, eb, hb, _) = _both(_tiny, 3, np.full(3, 0.2), 0.3, 10, 400, 4, Stagnation(patience=1000))
     assert len(ha) < 400 and (ea - 1) % 10 == 1  # x0, whole generations, then the mean alone
     assert (eb, hb) == (ea, ha)
+
+
+@pytest.mark.parametrize("seed", [0, 2**32, 2**40 + 3])
+def test_seeds_cma_cannot_take_give_the_same_run_twice(seed):
+    # cma seeds itself from the clock for 0, and numpy refuses 2**32 and above: `cma_seed` maps them
+    from emaphm.identification.cmaes import cma_seed
+
+    runs = []
+    for _ in range(2):
+        problem = BatchProblem(_valley, np.zeros(4), np.ones(4))
+        runs.append(cmaes_minimize(problem, np.full(4, 0.5), 0.2, 8, 12, seed=seed, stagnation=Stagnation(patience=100)))
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    assert runs[0][1:] == runs[1][1:]
+    assert 0 < cma_seed(seed) < 2**32 and cma_seed(7) == 7 and cma_seed(2**32 - 1) == 2**32 - 1

@@ -42,7 +42,7 @@ def test_the_plans_end_no_later_than_pairs_alone_and_split_a_pair_where_that_end
     assert n_pairs == 2 and sorted(owner) == [0, 0, 1, 1]
 
 
-@pytest.mark.parametrize("n_threads", [1, 2, 3])
+@pytest.mark.parametrize("n_threads", [0, 1, 2, 3])  # 0: as one (every row still written)
 def test_the_kernels_give_the_same_numbers_whatever_the_plan(n_threads):
     theta_cmd, rows, _, f = population(n_rows=13, duration=0.1)
     keep = np.flatnonzero(f.weights > 0)

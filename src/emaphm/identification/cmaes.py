@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from .ga import Termination
 from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
 
-__all__ = ["CMA_UNUSED_IMPORTS", "cmaes", "cmaes_minimize", "import_cmaes"]
+__all__ = ["CMA_UNUSED_IMPORTS", "cma_seed", "cmaes", "cmaes_minimize", "import_cmaes"]
 
 # what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)
 CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
@@ -112,6 +112,14 @@ def cmaes(x0: NDArray[np.float64], sigma: float, pop_size: int, generations: int
     return CMAES(x0=x0, sigma=sigma, popsize=pop_size, restarts=0, maxiter=generations)
 
 
+def cma_seed(seed: int) -> int:
+    """`seed` as `cma` can take it: `cma` seeds itself from the clock for 0 and numpy refuses
+    2³² and above, so those become 1 + seed mod (2³² − 1); every other seed stays itself (the
+    same runs as before). Without it a polish from seed 0 was not reproducible."""
+    seed = int(seed)
+    return seed if 0 < seed < 2**32 else 1 + seed % (2**32 - 1)
+
+
 def cmaes_minimize(
     problem: BatchProblem,
     x0: NDArray[np.float64],
@@ -123,11 +131,12 @@ def cmaes_minimize(
     stagnation: Stagnation,
     on_generation: OnGeneration | None = None,
 ) -> tuple[NDArray[np.float64], float, list[float]]:
-    """The CMA-ES from x0 with step `sigma` (in the box normalised to [0, 1]) and population
-    `pop_size` on `problem` for at most `generations` (x0's evaluation the first; fewer when
-    `stagnation` stops it or `cma` does): the best point (clipped to the box), its value and the
-    best value per generation, as ``minimize_batch(problem, cmaes(...), generations, ...)`` gives
-    them (the module docstring)."""
+    """The CMA-ES from the point x0 with step `sigma` (in the box normalised to [0, 1]) and
+    population `pop_size` on `problem` for at most `generations` (x0's evaluation the first; fewer
+    when `stagnation` stops it or `cma` does): the best point (clipped to the box), its value and
+    the best value per generation, as ``minimize_batch(problem, cmaes(...), generations, ...)``
+    gives them (the module docstring) with `cma_seed`(seed) for the seed."""
+    seed = cma_seed(seed)
     xl, xu = problem.xl, problem.xu
     span = xu - xl
     x_best = np.atleast_2d(np.asarray(x0, dtype=np.float64))  # pymoo's first population: x0
@@ -156,7 +165,7 @@ def cmaes_minimize(
         values = F.tolist()
         try:
             asked = es.send(values if many else values[0])
-        except Exception:  # pymoo's CMAES ends on any error of the generator (its end: StopIteration)
+        except Exception:  # the generator's end (StopIteration) or error: pymoo's CMAES ends there too
             asked = None
         if asked is None:
             termination.forced = True

@@ -104,17 +104,17 @@ class Fitness:
         """The samples eq. (3) weighs (w > 0), their √w and the reference there: the residual
         vector's layout (`residuals_of_monitor`, r = √w·(I_ref − I_LF) on these samples).
 
-        Kept (read-only) for the weights and reference it was taken from, which a least-squares
-        descent asks for at every round (a few hundred times a diagnosis, 40 µs each: issue 36);
-        a `shifted` copy, with its own reference, takes its own."""
+        Kept for the weights and reference it was taken from, which a least-squares descent asks
+        for at every round (a few hundred times a diagnosis, 40 µs each: issue 36); a `shifted`
+        copy, with its own reference, takes its own. Shared: not to be changed in place (read-only
+        arrays would be another signature of the fused kernel, which the start table's build
+        calls with its own writable ones)."""
         weights, reference = self.weights, self.comparison.reference
         kept = getattr(self, "_weighed", None)
         if kept is not None and kept[0] is weights and kept[1] is reference:
             return kept[2]  # type: ignore[no-any-return]
         keep = np.flatnonzero(weights > 0)
         out = (keep, np.sqrt(weights[keep]), reference[keep])
-        for array in out:
-            array.setflags(write=False)
         self._weighed = (weights, reference, out)
         return out
 

@@ -84,6 +84,10 @@ def run_optimizer(
     if name == "ga":  # pymoo's GA on arrays, the same generations to the bit (`ga`)
         return genetic_algorithm(problem, pop_size, generations, seed, stop, on_generation,
                                  None if initial is None else np.array(initial), offspring)  # fmt: skip
+    if name == "cmaes":  # the seed as `cma` can take it (0 would be the clock's)
+        from .cmaes import cma_seed
+
+        seed = cma_seed(seed)
     x, f, history, res = run_pymoo(
         problem, _pymoo_algorithm(name, pop_size, generations, n_var, rng, initial, offspring),
         stop.termination(generations),

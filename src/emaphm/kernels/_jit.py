@@ -125,16 +125,19 @@ class QuickLoadCache(caching.FunctionCache):  # type: ignore[misc]
 
 @contextlib.contextmanager
 def _llvm_lock_events_off() -> Iterator[None]:
-    """Without the callbacks on llvmlite's lock inside the block (`QuickLoadCache`'s loads).
+    """Without any callback on llvmlite's lock inside the block (`QuickLoadCache`'s loads).
 
     numba registers two (``numba.core.base._initialize_llvm_lock_event``) that broadcast a
     "numba:llvm_lock" event before and after every one of llvmlite's calls, so that a compilation
     can time its share of LLVM's lock; loading one cached kernel makes about 300 such calls, and
     the events were 10-15 % of the loads' time (3 515 calls, about 15 ms of every diagnosis's
-    start on machine G, issue 36). A load times nothing, and it runs under numba's compiler lock,
-    so no compilation misses its events (the runtime's first initialisation, which compiles
-    NRT's functions, runs inside the block too). The callbacks are put back afterwards in their order;
-    where llvmlite keeps them elsewhere than ``ffi.lib._lock._cblist``, nothing changes."""
+    start on machine G, issue 36). All the lock's callbacks (numba's and any other's) are off in
+    the block and put back afterwards, in their order. A load times nothing, and it runs under
+    numba's compiler lock, so no dispatcher's compilation runs meanwhile; the one compilation
+    inside the block, the runtime's first initialisation (NRT's functions), fires no events. Another
+    thread's llvmlite call while the list changes (a finaliser) may see one event without its
+    pair, which only a timer listening to these events would notice. Where llvmlite keeps the
+    callbacks elsewhere than ``ffi.lib._lock._cblist``, nothing changes."""
     lock = getattr(getattr(ffi, "lib", None), "_lock", None)
     callbacks = list(getattr(lock, "_cblist", ()))
     for acquire, release in callbacks:

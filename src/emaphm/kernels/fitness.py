@@ -270,7 +270,7 @@ def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads):
     (``numba.get_num_threads()``; a kernel that asks numba itself cannot be cached).
     """
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
-    for t in prange(n_threads):
+    for t in prange(max(n_threads, 1)):  # the plan's threads are 0 … max(n_threads, 1) − 1
         for task in range(owner.shape[0]):
             if owner[task] == t:
                 r, pair = planned_task(task, n_pairs)
@@ -294,7 +294,7 @@ def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out,
     LF current is not finite gets NaN residuals. `n_threads` as in `fitness_lf_many`.
     """
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
-    for t in prange(n_threads):
+    for t in prange(max(n_threads, 1)):
         for task in range(owner.shape[0]):
             if owner[task] == t:
                 r, pair = planned_task(task, n_pairs)
