@@ -64,6 +64,13 @@ def drive_fields(params: EmaParams, n_lf: int) -> dict[str, float]:
     }
 
 
+def _with_faults(rows: NDArray[np.float64], K: NDArray[np.float64], params: EmaParams) -> NDArray[np.float64]:
+    """`rows` (m, N_FIELDS) with the fields the fault rows K set (DESIGN §2), in place."""
+    for name, values in fault_parameter_columns(K, params).items():
+        rows[:, IDX[name]] = values
+    return rows
+
+
 def monitor_rows(
     K: NDArray[np.float64],
     params: EmaParams,
@@ -81,9 +88,7 @@ def monitor_rows(
     if len(coefficients) not in (1, m):
         raise ValueError(f"need 1 or {m} coefficient sets, got {len(coefficients)}")
     tr, c, sens, mot = params.transmission, params.controller, params.sensors, params.motor
-    rows = np.empty((m, N_FIELDS))
-    for name, values in fault_parameter_columns(K, params).items():
-        rows[:, IDX[name]] = values
+    rows = _with_faults(np.empty((m, N_FIELDS)), K, params)
     fixed = {
         "C": tr.C, "tau": tr.tau, "eta": tr.eta, "theta_max": tr.theta_max, "T_load": tr.T_load,
         "K_I": c.K_I, "K_D": c.K_D, "tau_D": c.tau_D, "I_max": c.I_max, "T_s": 1.0 / c.f_s,
@@ -169,10 +174,7 @@ class MonitorEma(_EmaModel):
         if kept is None or kept[0] is not params or kept[1] is not cal:
             template = monitor_rows(np.zeros((1, len(FAULT_NAMES))), params, [cal.coefficients], cal.n_lf, cal.monitor)[0]
             kept = self._row_template = (params, cal, template)
-        rows = np.repeat(kept[2][None, :], len(K), axis=0)
-        for name, values in fault_parameter_columns(K, params).items():
-            rows[:, IDX[name]] = values
-        return rows
+        return _with_faults(np.repeat(kept[2][None, :], len(K), axis=0), K, params)
 
     def simulate_many(
         self, K: ArrayLike, *, duration: float | None = None, check: bool = True

@@ -139,8 +139,6 @@ def laplace(
     k_hat = np.asarray(k_hat, dtype=np.float64)
     u0 = to_cartesian(k_hat)[0]
     factors = factors if factors is not None else Factors.identity()
-    keep = objective.weights > 0
-    n = int(keep.sum())
     rows = [u0]
     spans = []
     for h in LAPLACE_STEPS:
@@ -155,7 +153,7 @@ def laplace(
             spans.append(up[j] - down[j])
     K = np.clip(to_faults(np.array(rows)), 0.0, 1.0)
     R = _residuals(objective, monitor, K, duration)
-    r0 = R[0]
+    r0, n = R[0], R.shape[1]  # n: the samples eq. 3 weighs
     if not np.all(np.isfinite(r0)):
         raise InputError("the monitor diverges at the estimate: no uncertainty can be given")
     ssr = float(np.sum(r0 * r0))  # numpy's pairwise sum: the same whatever the rows' layout and BLAS
@@ -210,9 +208,9 @@ def _residuals(objective: Fitness, monitor: MonitorEma, K: NDArray[np.float64], 
 
     if isinstance(monitor, MonitorEma):
         return objective.residuals_of_monitor(monitor, K, duration=duration)
-    keep = objective.weights > 0
+    keep, root_w, reference = objective.weighed()  # the fused kernel's layout
     currents = monitor.simulate_many(K, duration=duration, check=False)
-    return np.sqrt(objective.weights[keep]) * (objective.comparison.reference[keep] - objective.comparison.filtered(currents)[:, keep])  # type: ignore[no-any-return]
+    return root_w * (reference - objective.comparison.filtered(currents)[:, keep])  # type: ignore[no-any-return]
 
 
 def _widened(calibrated: NDArray[np.float64], objective: Fitness, monitor: MonitorEma, k_hat: NDArray[np.float64],
