@@ -54,6 +54,13 @@ def _fresh(code: str) -> list[str]:
     return out.stdout.split()
 
 
+def _fresh_loaded(code: str) -> list[str]:
+    """`_fresh`'s output of `code` in a second process: on a cold cache (a fresh machine) the
+    first compiles the kernels, so that the second loads them, as a diagnosis usually does."""
+    _fresh(code)
+    return _fresh(code)
+
+
 def test_a_blas_loaded_inside_the_block_gets_one_thread_only_when_said():
     # a fresh process: scipy's own BLAS is not loaded until scipy.optimize is imported
     code = (
@@ -88,8 +95,7 @@ def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
         "import numba\n"
         "print(numba.njit(lambda a: np.linalg.det(a))(np.eye(3)))\n"
     )
-    _fresh(code)  # a cold cache compiles here (a fresh machine): the second process loads
-    out = _fresh(code)
+    out = _fresh_loaded(code)
     assert out[0] == "False" and out[1] == "[]", out
     assert out[2:4] == ["True", "0"], out  # loaded from the cache, not compiled
     assert out[4] == "1.0"
@@ -112,8 +118,7 @@ def test_a_kernel_load_fires_no_llvm_lock_events_and_a_compilation_still_does():
         "numba.njit(lambda a: a + 1)(1.0)\n"
         "print(len(calls) > 0)\n"
     )
-    _fresh(code)  # a cold cache compiles here (a fresh machine): the second process loads
-    out = _fresh(code)
+    out = _fresh_loaded(code)
     assert out == ["0", "True", "True", "True"], out
 
 
