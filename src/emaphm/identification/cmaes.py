@@ -47,7 +47,7 @@ def import_cmaes() -> Any:
     them afterwards, but in this process `cma`'s own plots stay unavailable and its surrogate
     models use its fallback. pymoo's CMAES imports pymoo's hypervolume (through its default
     termination), which imports `moocore` with its data sets, ``urllib.request`` and
-    ``platformdirs`` (12 ms on machine G, issue 36) for multi-objective indicators: while pymoo is
+    ``platformdirs`` (14 ms on machine G, issue 36, `studies/step_timings.py`) for multi-objective indicators: while pymoo is
     imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions import the real one when
     first called, so pymoo's indicators still work. Only when no other Python thread runs
     (another thread could import them meanwhile): the CLI calls this before its progress bar

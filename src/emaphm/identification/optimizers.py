@@ -98,7 +98,7 @@ class RelativeObjectiveTermination(DeltaToleranceTermination):  # type: ignore[m
     Built on pymoo's `DeltaToleranceTermination` with `SingleObjectiveSpaceTermination`'s `_data`
     (the best feasible value, inf when none) instead of subclassing it: its module
     (``pymoo.termination.ftol``) imports pymoo's hypervolume and with it `moocore` (its data sets,
-    ``urllib.request``, ``platformdirs``), about 12 ms of every diagnosis's start for a
+    ``urllib.request``, ``platformdirs``), about 14 ms of every diagnosis's start for a
     multi-objective indicator (issue 36). `tests/identification/test_optimizers.py` checks both
     stop at the same generation.
     """

@@ -21,7 +21,7 @@ initialises the runtime and nothing else; a compilation still refreshes the cont
 (numba's `CompilerBase.__init__`), so a cache miss, or any other jitted function, compiles as
 before. Where numba's cache lacks the two methods it builds on, the kernels keep numba's own. A
 load also runs without numba's events on LLVM's lock (`_llvm_lock_events_off`), which time a
-compilation and cost a load 10-15 % of its time.
+compilation and cost a load about a tenth of its time.
 """
 
 from __future__ import annotations
@@ -130,8 +130,8 @@ def _llvm_lock_events_off() -> Iterator[None]:
     numba registers two (``numba.core.base._initialize_llvm_lock_event``) that broadcast a
     "numba:llvm_lock" event before and after every one of llvmlite's calls, so that a compilation
     can time its share of LLVM's lock; loading one cached kernel makes about 300 such calls, and
-    the events were 10-15 % of the loads' time (3 515 calls, about 15 ms of every diagnosis's
-    start on machine G, issue 36). All the lock's callbacks (numba's and any other's) are off in
+    the events were about a tenth of the loads' time (3 515 calls; the Table 1 case's eleven loads
+    107 ms with them, 96 ms without on machine G, `studies/step_timings.py`, issue 36). All the lock's callbacks (numba's and any other's) are off in
     the block and put back afterwards, in their order. A load times nothing, and it runs under
     numba's compiler lock, so no dispatcher's compilation runs meanwhile; the one compilation
     inside the block, the runtime's first initialisation (NRT's functions), fires no events. Another

@@ -2,10 +2,12 @@
 `fitness.residuals_lf_many`).
 
 A thread runs two rows at once faster than one after the other (`monitor.simulate_lf2`, and the
-comparison filter of two currents interleaved): on machine G a pair took 1.16 ms where one row took
-0.69 ms (10 001 samples), so a batch goes in pairs. But pairs alone leave threads idle at the
+comparison filter of two currents interleaved): on machine G a pair took 1.06-1.22 ms where one row
+took 0.65-0.77 ms (10 001 samples; 4 rows and 1 row on two threads, `studies/step_timings.py`), so a
+batch goes in pairs. But pairs alone leave threads idle at the
 end of a batch whose pairs do not divide among them: 6 rows as 3 pairs on 2 threads take two
-pairs' time (2.3 ms) where 2 pairs and 2 single rows take a pair and a row on each (1.85 ms).
+pairs' time where 2 pairs and 2 single rows take a pair and a row on each (2.11 -> 1.67-1.80 ms
+on machine G, `studies/step_timings.py`).
 `batch_plan` turns up to one pair per thread into two single rows where that ends the batch
 sooner, by the longest-processing-time rule with a pair costing `PAIR_COST` rows. Which thread
 runs a row does not change its numbers (a row alone is `monitor.simulate_lf`'s, in a pair
@@ -18,7 +20,7 @@ import numpy as np
 
 from ._jit import jit
 
-# a pair of rows on one thread, in single rows' time (machine G: 1.16 / 0.69 ms; E: 1.2-1.6)
+# a pair of rows on one thread, in single rows' time (machine G: 1.06-1.22 / 0.65-0.77 ms; E: 1.2-1.6)
 PAIR_COST = 1.7
 
 

@@ -166,7 +166,7 @@ class MonitorEma(_EmaModel):
     def rows(self, K: ArrayLike) -> NDArray[np.float64]:
         """Validated LF parameter rows for the fault rows K: `monitor_rows`' numbers, its fields
         that the faults do not set taken from one row built once for this actuator and
-        calibration (the search asks for rows a few hundred times a diagnosis: 38 -> 20 µs each,
+        calibration (the search asks for rows a few hundred times a diagnosis: 8 rows 31-35 -> 21 µs, `studies/step_timings.py`,
         issue 36)."""
         K = as_fault_matrix(K)
         params, cal = self.params, self.calibration

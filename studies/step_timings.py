@@ -1,0 +1,144 @@
+"""Issue 36, fourteenth session: the in-process timings behind its steps (BENCHMARKS.md, "Exact
+cuts: kernel loads, ..."), measured on the current code.
+
+    python studies/step_timings.py [--repeats 5]
+
+Prints, each as the median (min-max) over --repeats:
+1. the Table 1 case's kernel loads in a fresh process (the overloads its diagnosis used in this
+   process, each loaded by ``dispatcher.compile``), with numba's events on LLVM's lock off during
+   a load (`kernels._jit._llvm_lock_events_off`, the code as it is) and on (that block replaced by
+   a no-op in the subprocess);
+2. what the `moocore` stand-in spares `import_cmaes` in a fresh process after the identification's
+   imports: ``import moocore`` there;
+3. `lm_descent.gram` against ``np.einsum("ik,jk->ij")`` for an 8 × 10 001 Jᵀ (the same numbers);
+4. the fused residual kernel per batch size on two threads, random rows against the Table 1
+   case's recording, with the batch plan (`kernels.batches`);
+5. the monitor's parameter rows for 8 fault rows: built whole (`lf.monitor_rows`) and from the
+   monitor's template row (`MonitorEma.rows`).
+Run on an older tree (``PYTHONPATH=<worktree>/src``) it times what that tree has: no events'
+block, no `gram`, the fused kernel without its thread count (then its pairs alone).
+Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import os
+import pickle
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+TABLE1 = [0.2383, 0.5003, 0.0, 0.4503, 0.0404, 0.0028, 0.2785, 0.5]
+
+LOADS = """
+import contextlib, importlib, pickle, sys, time
+import emaphm.identification.api
+from emaphm.kernels import _jit
+if sys.argv[2] == "on" and hasattr(_jit, "_llvm_lock_events_off"):
+    _jit._llvm_lock_events_off = contextlib.nullcontext
+with open(sys.argv[1], "rb") as f:
+    sigs = [(getattr(importlib.import_module(m), n), s) for m, n, s in pickle.load(f)]
+t = time.perf_counter()
+for k, s in sigs:
+    k.compile(s)
+print(time.perf_counter() - t, len(sigs))
+"""
+
+MOOCORE = """
+import time
+import emaphm.identification.api
+t = time.perf_counter()
+import moocore
+print(time.perf_counter() - t)
+"""
+
+
+def spread(values: list[float], scale: float = 1e3) -> str:
+    v = np.asarray(values) * scale
+    return f"{np.median(v):.2f} ({v.min():.2f}-{v.max():.2f})"
+
+
+def fresh(code: str, *args: str) -> list[str]:
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, check=True).stdout.split()
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args(argv)
+    import numba
+
+    import emaphm
+    from emaphm.identification.fitness import Fitness
+    from emaphm.identification.signals import Comparison
+    from emaphm.kernels import _jit, fitness, hf_twin, monitor, pmsm_abc, sensors, transforms
+    from emaphm.kernels.fitness import residuals_lf_many
+
+    numba.set_num_threads(2)
+    emaphm.identify(true_faults=TABLE1, seed=1)  # the kernels cached and loaded, the table built
+    kernels = (pmsm_abc.ecc_harmonics, sensors.adc, transforms.clarke, transforms.park, hf_twin.simulate_hf,
+               fitness.sosfiltfilt_one, fitness.sosfiltfilt_many, fitness.fitness_lf_many, fitness.residuals_lf_many,
+               monitor.simulate_lf, monitor.simulate_lf_many)  # fmt: skip
+    used = [(k.py_func.__module__, k.__name__, s) for k in kernels for s in k.signatures]
+    with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as f:
+        pickle.dump(used, f)
+    try:
+        modes = ("off", "on") if hasattr(_jit, "_llvm_lock_events_off") else ("on",)
+        for mode in modes:
+            runs = [fresh(LOADS, f.name, mode) for _ in range(args.repeats)]
+            print(f"1. kernel loads, events {mode}: {spread([float(r[0]) for r in runs])} ms ({runs[0][1]} overloads)")
+    finally:
+        os.unlink(f.name)
+    print(f"2. import moocore after the identification's imports: {spread([float(fresh(MOOCORE)[0]) for _ in range(args.repeats)])} ms")
+    from emaphm.identification import lm_descent  # (a module of the thirteenth session on)
+
+    Jt = np.random.default_rng(36).standard_normal((8, 10_001))
+    ways = {"einsum": lambda: np.einsum("ik,jk->ij", Jt, Jt)}
+    if hasattr(lm_descent, "gram"):
+        ways["gram"] = lambda: lm_descent.gram(Jt)
+    for name, way in ways.items():
+        times = []
+        for _ in range(args.repeats):
+            t = time.perf_counter()
+            for _ in range(100):
+                way()
+            times.append((time.perf_counter() - t) / 100)
+        print(f"3. J^T J of 8 x 10 001 by {name}: {spread(times)} ms")
+    monitor = emaphm.MonitorEma()
+    trace = emaphm.HighFidelityEma().simulate(TABLE1, seed=1)
+    fit = Fitness(Comparison.from_signal(trace.t, trace.i_q, monitor.params.controller.f_s))
+    keep, root_w, reference = fit.weighed()
+    _, theta_cmd = monitor.sample_grid(None)
+    K = np.random.default_rng(1).uniform(0, 1, (18, 8))
+    threads = ((2,) if "n_threads" in inspect.signature(residuals_lf_many.py_func).parameters else ())
+    for n in (1, 2, 4, 6, 8, 9, 18):
+        rows, out = monitor.rows(K[:n]), np.empty((n, len(keep)))
+        times = []
+        for _ in range(args.repeats):
+            t = time.perf_counter()
+            for _ in range(10):
+                residuals_lf_many(theta_cmd, rows, fit.sos, fit.zi, fit.padlen, keep, reference, root_w, out, *threads)
+            times.append((time.perf_counter() - t) / 10)
+        print(f"4. the fused residual kernel, {n} rows on 2 threads: {spread(times)} ms")
+    from emaphm.models.lf import monitor_rows
+
+    cal = monitor.calibration
+    ways = {"monitor_rows": lambda: monitor_rows(K[:8], monitor.params, [cal.coefficients], cal.n_lf, cal.monitor),
+            "MonitorEma.rows": lambda: monitor.rows(K[:8])}  # fmt: skip
+    for name, way in ways.items():
+        times = []
+        for _ in range(args.repeats):
+            t = time.perf_counter()
+            for _ in range(1000):
+                way()
+            times.append((time.perf_counter() - t) / 1000)
+        print(f"5. 8 parameter rows by {name}: {spread(times, 1e6)} us")
+
+
+if __name__ == "__main__":
+    main()
