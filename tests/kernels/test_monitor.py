@@ -179,9 +179,32 @@ def test_index_constants_match_the_row_layout():
     for j, name in enumerate(LF_FIELDS):
         assert getattr(lf_kernel, name.upper()) == j, name
     # and no other upper-case integer constant pretends to be a field index
-    others = {"N_FIELDS", "N_AUX", "PAIR_MIN_ROWS"}
+    others = {"N_FIELDS", "N_AUX", "PAIR_MIN_ROWS", "ANGLE_RESYNC"}
     constants = {n for n, v in vars(lf_kernel).items() if n.isupper() and type(v) is int and n not in others}
     assert constants == {name.upper() for name in LF_FIELDS}
+
+
+def test_the_carried_angle_follows_libm_to_rounding():
+    # `advance_angle` rotates sin θ_e and cos θ_e through each step's turn instead of calling libm:
+    # over a whole resync period of random turns up to ROTATION_MAX (either sign, from any angle,
+    # p = 4 as the actuator's) it stays within a few ulp of libm's values of the angle reached,
+    # and on the unit circle; a turn beyond ROTATION_MAX and the ANGLE_RESYNC-th step are libm's own
+    rng = np.random.default_rng(3)
+    p, worst = 4.0, 0.0
+    for _ in range(200):
+        theta = rng.uniform(-50.0, 50.0)
+        s, c, n = np.sin(p * theta), np.cos(p * theta), 0
+        for _ in range(lf_kernel.ANGLE_RESYNC - 1):
+            new = theta + rng.uniform(-1.0, 1.0) * lf_kernel.ROTATION_MAX / p
+            s, c, n = lf_kernel.advance_angle(s, c, n, p, theta, new)
+            theta = new
+            worst = max(worst, abs(s - np.sin(p * theta)), abs(c - np.cos(p * theta)), abs(s * s + c * c - 1.0))
+        assert n == lf_kernel.ANGLE_RESYNC - 1
+        s, c, n = lf_kernel.advance_angle(s, c, n, p, theta, theta + 1e-4)
+        assert (s, c, n) == (np.sin(p * (theta + 1e-4)), np.cos(p * (theta + 1e-4)), 0)
+    assert 0.0 < worst < 1e-14
+    big = 1.01 * lf_kernel.ROTATION_MAX / p
+    assert lf_kernel.advance_angle(0.3, 0.9, 3, p, 1.0, 1.0 + big) == (np.sin(p * (1.0 + big)), np.cos(p * (1.0 + big)), 0)
 
 
 @pytest.mark.parametrize(

@@ -56,13 +56,16 @@ def friction_step(
     when the ripple's peak would. 0 (the HF twin, which resolves its ripple) is the plain model.
     A breakaway whose mean torque cannot beat F_D stays stuck for the step.
     """
+    # Δt/J: a division a run rather than one a step in the chain ω → θ → torque → ω, once a
+    # caller's loop hoists it (its operands are the loop's constants; issue 36, fifteenth session)
+    dt_J = dt / J
     if omega_m == 0.0:
         if abs(T_act) + T_ripple <= F_S:  # case 1
             return 0.0
         s = 1.0 if T_act > 0.0 else -1.0  # case 2
-        return dt * max(abs(T_act) - F_D, 0.0) * s / J
+        return dt_J * max(abs(T_act) - F_D, 0.0) * s
     s = 1.0 if omega_m > 0.0 else -1.0
-    omega_new = omega_m + dt * (T_act - C * omega_m - F_D * s) / J  # case 3
+    omega_new = omega_m + dt_J * (T_act - C * omega_m - F_D * s)  # case 3
     if omega_new * s <= 0.0:  # case 4
         return 0.0
     return omega_new
@@ -98,7 +101,7 @@ def mechanics_step(
     T_act = T_m - mp.T_load / (mp.tau * mp.eta)  # DESIGN §3.8, load reflected through the gear
     omega_m = friction_step(omega_m, T_act, dt, mp.J, mp.C, mp.F_S, mp.F_D, T_ripple)
     theta_m += dt * omega_m
-    theta_u = backlash(theta_m / mp.tau, theta_u, mp.B)
+    theta_u = backlash(theta_m * (1.0 / mp.tau), theta_u, mp.B)  # 1/τ a run (as Δt/J above)
     # inelastic end-stops on the user side: the gear flank pressing the user into the stop is
     # held at the stop and loses its speed towards it
     if theta_u > mp.theta_max:

@@ -297,15 +297,42 @@ def lf_constants(prm):  # type: ignore[no-untyped-def]
     return cp, mp, n_lf, dt, decay, decay_rl, g, prm[P], offset_0, kz_cos, kz_sin, per_phase, e2, foc, h_u
 
 
+# The electrical angle's sine and cosine are carried from step to step and rotated through the
+# step's angle d = p·(θ_m,new − θ_m) (`advance_angle`): sin and cos of libm were about a quarter of a
+# step's time (issue 36, fifteenth session). The series below are exact to rounding up to
+# ROTATION_MAX (the first terms left out, d¹³/13! and d¹⁴/14!, are below 2e-18 there; a 100 µs step
+# turned θ_e by at most 0.06 rad in 30 random runs of the chirp); a larger turn (an end-stop's jump)
+# and every ANGLE_RESYNC-th step take libm's values afresh, so rounding cannot accumulate.
+ROTATION_MAX = 0.2
+ANGLE_RESYNC = 32
+# Taylor coefficients of sin d and cos d − 1
+S3, S5, S7, S9, S11 = -1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0, -1.0 / 39916800.0
+C2, C4, C6, C8, C10, C12 = -0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0, -1.0 / 3628800.0, 1.0 / 479001600.0
+
+
 @jit(inline=True)
-def lf_substep(theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_q_ref, prm, c):  # type: ignore[no-untyped-def]
+def advance_angle(sin_e, cos_e, n_rot, p, theta_m, theta_new):  # type: ignore[no-untyped-def]
+    """(sin θ_e, cos θ_e, steps since libm) after θ_m moved to theta_new: rotated through
+    d = p·(theta_new − θ_m) by Taylor series (sin d to d¹¹, cos d − 1 to d¹²), or taken from libm
+    every `ANGLE_RESYNC` steps and when |d| > `ROTATION_MAX`."""
+    d = p * (theta_new - theta_m)
+    n_rot += 1
+    if n_rot >= ANGLE_RESYNC or abs(d) > ROTATION_MAX:
+        theta_e = p * theta_new
+        return math.sin(theta_e), math.cos(theta_e), 0
+    d2 = d * d
+    sin_d = d * (1.0 + d2 * (S3 + d2 * (S5 + d2 * (S7 + d2 * (S9 + d2 * S11)))))
+    cos_d_m1 = d2 * (C2 + d2 * (C4 + d2 * (C6 + d2 * (C8 + d2 * (C10 + d2 * C12)))))
+    return sin_e + (sin_e * cos_d_m1 + cos_e * sin_d), cos_e + (cos_e * cos_d_m1 - sin_e * sin_d), n_rot
+
+
+@jit(inline=True)
+def lf_substep(theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_q_ref, prm, c, sin_e, cos_e, n_rot):  # type: ignore[no-untyped-def]
     """One LF step of dt (`simulate_lf`'s inner loop) from the state (θ_m, ω_m, θ_u, the loop's
-    current i, the FOC loop's I_q, v_1, v_2) under the held demand i_q_ref; c = `lf_constants`(prm).
-    Returns the new state and the step's i_m and T_m (which `simulate_lf` averages)."""
+    current i, the FOC loop's I_q, v_1, v_2, and sin θ_e, cos θ_e with the steps since they were
+    libm's: `advance_angle`) under the held demand i_q_ref; c = `lf_constants`(prm). Returns the
+    new state and the step's i_m and T_m (which `simulate_lf` averages)."""
     _, mp, _, dt, decay, decay_rl, g, p, offset_0, kz_cos, kz_sin, per_phase, e2, foc, h_u = c
-    theta_e = p * theta_m
-    sin_e = math.sin(theta_e)
-    cos_e = math.cos(theta_e)
     f_sc = phi_sc(sin_e, cos_e, prm[N_A], prm[N_B], prm[N_C], prm[K_FT], prm[K_FS])
     f_ecc = phi_ecc(sin_e, cos_e, kz_cos, kz_sin)
     if per_phase:  # φ_T = φ_E, and the torque constant k_t,eq·φ_T
@@ -332,8 +359,9 @@ def lf_substep(theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_q_ref, prm, c):  #
     # the hysteresis loop's ripple about i_m, which this step averages away, breaks a stuck
     # motor away at its peak: T_ripple = k_t,eq·φ_T·i_R (monitor-model.md §1)
     T_r = abs(k_t) * prm[I_R]
-    theta_m, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp, T_r)
-    return theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_m, T_m
+    theta_new, omega_m, theta_u = mechanics_step(theta_m, omega_m, theta_u, T_m, dt, mp, T_r)
+    sin_e, cos_e, n_rot = advance_angle(sin_e, cos_e, n_rot, p, theta_m, theta_new)
+    return theta_new, omega_m, theta_u, i, I_q, v_1, v_2, i_m, T_m, sin_e, cos_e, n_rot
 
 
 @jit
@@ -358,6 +386,7 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
     theta_m = omega_m = theta_u = 0.0
     i = integral = omega_f = 0.0
     acc_i = acc_T = 0.0
+    sin_e, cos_e, n_rot = 0.0, 1.0, 0  # θ_e = 0 at rest
     for k in range(n):
         theta_meas = quantise(theta_u, prm[LSB_THETA], prm[FS_THETA])
         i_q_ref, integral, omega_f = pid_step(theta_cmd[k], theta_meas, omega_m, integral, omega_f, cp)
@@ -374,8 +403,8 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
         acc_i = 0.0
         acc_T = 0.0
         for _ in range(n_lf):
-            theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_m, T_m = lf_substep(
-                theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_q_ref, prm, c
+            theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_m, T_m, sin_e, cos_e, n_rot = lf_substep(
+                theta_m, omega_m, theta_u, i, I_q, v_1, v_2, i_q_ref, prm, c, sin_e, cos_e, n_rot
             )
             acc_i += i_m
             acc_T += T_m
@@ -405,6 +434,8 @@ def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-unty
     tma = oma = tua = tmb = omb = tub = 0.0
     ia = inta = ofa = ib = intb = ofb = 0.0
     acc_a = acc_b = 0.0
+    sa, csa, na = 0.0, 1.0, 0  # each row's sin θ_e, cos θ_e and steps since libm's
+    sb, csb, nb = 0.0, 1.0, 0
     for k in range(n):
         meas_a = quantise(tua, prm_a[LSB_THETA], prm_a[FS_THETA])
         meas_b = quantise(tub, prm_b[LSB_THETA], prm_b[FS_THETA])
@@ -417,8 +448,12 @@ def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-unty
         acc_a = 0.0
         acc_b = 0.0
         for _ in range(n_lf):
-            tma, oma, tua, ia, Iqa, v1a, v2a, ima, _ = lf_substep(tma, oma, tua, ia, Iqa, v1a, v2a, ref_a, prm_a, ca)
-            tmb, omb, tub, ib, Iqb, v1b, v2b, imb, _ = lf_substep(tmb, omb, tub, ib, Iqb, v1b, v2b, ref_b, prm_b, cb)
+            tma, oma, tua, ia, Iqa, v1a, v2a, ima, _, sa, csa, na = lf_substep(
+                tma, oma, tua, ia, Iqa, v1a, v2a, ref_a, prm_a, ca, sa, csa, na
+            )
+            tmb, omb, tub, ib, Iqb, v1b, v2b, imb, _, sb, csb, nb = lf_substep(
+                tmb, omb, tub, ib, Iqb, v1b, v2b, ref_b, prm_b, cb, sb, csb, nb
+            )
             acc_a += ima
             acc_b += imb
 
