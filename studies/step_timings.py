@@ -81,9 +81,16 @@ def main(argv: list[str] | None = None) -> None:
 
     numba.set_num_threads(2)
     emaphm.identify(true_faults=TABLE1, seed=1)  # the kernels cached and loaded, the table built
-    kernels = (pmsm_abc.ecc_harmonics, sensors.adc, transforms.clarke, transforms.park, hf_twin.simulate_hf,
-               fitness.sosfiltfilt_one, fitness.sosfiltfilt_many, fitness.fitness_lf_many, fitness.residuals_lf_many,
-               monitor.simulate_lf, monitor.simulate_lf_many)  # fmt: skip
+    # the kernels a diagnosis loads, in whichever tree runs this (after the fifteenth session the
+    # fused kernels and the filters are Python wrappers around `*_kernel` dispatchers, and the
+    # twin's measured i_q takes `transforms.q_error` instead of clarke and park)
+    names = ((pmsm_abc, "ecc_harmonics"), (sensors, "adc"), (transforms, "clarke"), (transforms, "park"),
+             (transforms, "q_error"), (hf_twin, "simulate_hf"), (fitness, "sosfiltfilt_one_kernel"),
+             (fitness, "sosfiltfilt_one"), (fitness, "sosfiltfilt_many_kernel"), (fitness, "sosfiltfilt_many"),
+             (fitness, "fitness_lf_kernel"), (fitness, "fitness_lf_many"), (fitness, "residuals_lf_kernel"),
+             (fitness, "residuals_lf_many"), (monitor, "simulate_lf"), (monitor, "simulate_lf_many_kernel"),
+             (monitor, "simulate_lf_many"))  # fmt: skip
+    kernels = [k for m, n in names if hasattr(k := getattr(m, n, None), "signatures")]
     used = [(k.py_func.__module__, k.__name__, s) for k in kernels for s in k.signatures]
     with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as f:
         pickle.dump(used, f)
@@ -115,7 +122,7 @@ def main(argv: list[str] | None = None) -> None:
     keep, root_w, reference = fit.weighed()
     _, theta_cmd = monitor.sample_grid(None)
     K = np.random.default_rng(1).uniform(0, 1, (18, 8))
-    threads = ((2,) if "n_threads" in inspect.signature(residuals_lf_many.py_func).parameters else ())
+    threads = ((2,) if "n_threads" in inspect.signature(getattr(residuals_lf_many, "py_func", residuals_lf_many)).parameters else ())
     for n in (1, 2, 4, 6, 8, 9, 18):
         rows, out = monitor.rows(K[:n]), np.empty((n, len(keep)))
         times = []

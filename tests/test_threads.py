@@ -83,14 +83,16 @@ def test_a_blas_loaded_inside_the_block_gets_one_thread_only_when_said():
 
 def test_a_diagnosis_loads_its_kernels_without_numbas_compiler_registries():
     # kernels/_jit.QuickLoadCache: a cached kernel loads without importing numba's lowering
-    # registries (numba.np.linalg is one); a compilation afterwards still works (it refreshes)
+    # registries (numba.np.linalg is one); a compilation afterwards still works (it refreshes).
+    # And no kernel a diagnosis loads allocates or uses array expressions, whose loads import
+    # numba's array and ufunc modules (kernels/fitness.py, STACK_SIZE's note): a whole diagnosis
+    # (polish, last stage, intervals) runs without them
     code = (
         "import sys, numpy as np\n"
         "from emaphm.identification.api import identify\n"
-        "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4,\n"
-        "         polish=False, last_stage='none', uncertainty='none')\n"
-        "print('numba.np.linalg' in sys.modules, [m for m in ('scipy.ndimage', 'scipy.spatial', 'scipy.optimize') if m in sys.modules])\n"
-        "from emaphm.kernels.fitness import fitness_lf_many\n"
+        "identify(true_faults=[0.1, 0.1, 0, 0.1, 0, 0, 0, 0.5], seed=1, generations=1, pop_size=4)\n"
+        "print('numba.np.linalg' in sys.modules, [m for m in ('scipy.ndimage', 'scipy.spatial', 'scipy.optimize', 'numba.np.arrayobj', 'numba.np.npyimpl') if m in sys.modules])\n"
+        "from emaphm.kernels.fitness import fitness_lf_kernel as fitness_lf_many\n"
         "print(sum(fitness_lf_many.stats.cache_hits.values()) > 0, sum(fitness_lf_many.stats.cache_misses.values()))\n"
         "import numba\n"
         "print(numba.njit(lambda a: np.linalg.det(a))(np.eye(3)))\n"

@@ -11,7 +11,13 @@ from emaphm._threads import numba_threads
 from emaphm.identification.fitness import Fitness
 from emaphm.identification.identifier import FaultIdentifier
 from emaphm.identification.signals import Comparison, sosfiltfilt_padlen
-from emaphm.kernels.fitness import filtered_fitness, fitness_lf_many, pairwise_sum, residuals_lf_many
+from emaphm.kernels.fitness import (
+    filtered_fitness,
+    fitness_lf_many,
+    pairwise_sum,
+    residuals_lf_many,
+    stack_for,
+)
 from emaphm.kernels.monitor import IDX
 
 # measured on x86-64 (numpy 2.4, scipy 1.17, numba 0.68): bit-identical. The tolerance leaves
@@ -58,7 +64,7 @@ def test_filter_and_sum_equal_scipy_and_numpy(f_s, n):
     x = 3.0 + np.cumsum(rng.normal(size=(2, n)), axis=1) * 0.05 + rng.normal(size=(2, n))
     e = np.empty((2, n + 2 * pad))
     e[:, pad : pad + n] = x
-    got = filtered_fitness(e[0], e[1], pad, sos, sosfilt_zi(sos), ref, weights)
+    got = filtered_fitness(e[0], e[1], pad, sos, sosfilt_zi(sos), ref, weights, stack_for()[0])
     want = np.sum(weights * (ref - sosfiltfilt(sos, x)) ** 2, axis=-1)
     np.testing.assert_allclose(got, want, rtol=RTOL, atol=0)
     assert got[0] != got[1]
@@ -75,7 +81,7 @@ def test_a_non_finite_current_gives_a_non_finite_fitness(where, bad):
     e[0, pad + where] = bad
     for first in (0, 1):  # the broken signal as the first or the second of the pair
         pair = e[[first, 1 - first]].copy()
-        got = filtered_fitness(pair[0], pair[1], pad, sos, sosfilt_zi(sos), np.zeros(n), np.ones(n))
+        got = filtered_fitness(pair[0], pair[1], pad, sos, sosfilt_zi(sos), np.zeros(n), np.ones(n), stack_for()[0])
         assert not np.isfinite(got[first])
         assert got[1 - first] == pytest.approx(np.sum(sosfiltfilt(sos, x) ** 2), rel=RTOL)  # untouched
 

@@ -10,6 +10,7 @@ from emaphm.kernels.monitor import (
     LF_FIELDS,
     N_AUX,
     N_FIELDS,
+    NO_AUX,
     loop_error,
     phi_ecc,
     phi_sc,
@@ -165,7 +166,7 @@ def test_interleaved_pairs_are_bit_identical_to_single_runs_of_any_two_rows():
              (hysteresis[0], hysteresis[0])]  # fmt: skip
     for a, b in pairs:
         out_a, out_b = np.full(len(theta_cmd), np.nan), np.full(len(theta_cmd), np.nan)
-        simulate_lf2(theta_cmd, a, b, out_a, out_b)
+        simulate_lf2(theta_cmd, a, b, out_a, out_b, NO_AUX)
         np.testing.assert_array_equal(out_a, single(a))
         np.testing.assert_array_equal(out_b, single(b))
     assert not np.array_equal(single(hysteresis[0]), single(foc[1]))  # the pairs mixed different runs

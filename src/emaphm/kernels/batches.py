@@ -16,6 +16,9 @@ runs a row does not change its numbers (a row alone is `monitor.simulate_lf`'s, 
 
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 
 from ._jit import jit
@@ -24,42 +27,41 @@ from ._jit import jit
 PAIR_COST = 1.7
 
 
-@jit
-def _makespan(n_pairs, n_singles, n_threads, owner):  # type: ignore[no-untyped-def]
+def _makespan(n_pairs: int, n_singles: int, n_threads: int, owner: list[int]) -> float:
     """The longest thread's load (in single rows) of `n_pairs` pairs then `n_singles` rows, each
-    given to the least loaded thread (the first of equals); `owner` (length ≥ the tasks) gets
-    each task's thread."""
-    load = np.zeros(n_threads)
+    given to the least loaded thread (the first of equals); `owner` gets each task's thread."""
+    load = [0.0] * n_threads
     for task in range(n_pairs + n_singles):
-        t = 0  # the least loaded, by hand: np.argmin's and max's code would make loading this
-        for u in range(1, n_threads):  # kernel import numba.np.arraymath (and its linalg)
-            if load[u] < load[t]:
-                t = u
-        owner[task] = t
+        t = min(range(n_threads), key=load.__getitem__)  # the first of the least loaded
+        owner.append(t)
         load[t] += PAIR_COST if task < n_pairs else 1.0
-    span = 0.0
-    for u in range(n_threads):
-        span = max(span, load[u])
-    return span
+    return max(load)
 
 
-@jit
-def batch_plan(n_runs, n_threads):  # type: ignore[no-untyped-def]
+def batch_plan(n_runs: int, n_threads: int) -> tuple[np.ndarray, int]:
     """(owner, n_pairs): rows 2q and 2q + 1 are task q for q < n_pairs, row n_pairs + q is task q
     alone after them; owner[q] is the thread (0 … n_threads − 1) that runs task q. Of the plans
     with up to `n_threads` pairs split into single rows, the one that ends soonest (ties: more
-    pairs)."""
+    pairs). Planned in Python, once per batch size and thread count (a read-only array, shared),
+    and passed to the kernels: planned in a kernel, it made the kernel allocate, and a kernel that
+    allocates loads with numba's array module (`fitness.STACK_SIZE`'s note)."""
+    return _plan(int(n_runs), int(n_threads))
+
+
+@functools.lru_cache(maxsize=512)
+def _plan(n_runs: int, n_threads: int) -> tuple[np.ndarray, int]:
     n_threads = max(1, min(n_threads, n_runs))
     most = n_runs // 2
-    trial = np.empty(n_runs, np.int64)
-    best_owner = np.empty(n_runs, np.int64)
-    best_pairs, best_span = most, np.inf
+    best_owner: list[int] = []
+    best_pairs, best_span = most, math.inf
     for n_pairs in range(most, max(-1, most - n_threads - 1), -1):
+        trial: list[int] = []
         span = _makespan(n_pairs, n_runs - 2 * n_pairs, n_threads, trial)
         if span < best_span - 1e-9:
-            best_pairs, best_span = n_pairs, span
-            best_owner[:] = trial
-    return best_owner[: n_runs - best_pairs], best_pairs
+            best_pairs, best_span, best_owner = n_pairs, span, trial
+    owner = np.array(best_owner, dtype=np.int64)
+    owner.flags.writeable = False
+    return owner, best_pairs
 
 
 @jit(inline=True)

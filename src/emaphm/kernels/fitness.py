@@ -35,7 +35,7 @@ from numba import prange
 
 from ._jit import jit
 from .batches import batch_plan, planned_task
-from .monitor import N_AUX, simulate_lf, simulate_lf2
+from .monitor import NO_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
 
@@ -79,43 +79,62 @@ def block_sum(a, lo, n):  # type: ignore[no-untyped-def]
     return res
 
 
+# pairwise_sum's explicit stack: frames of (lo, n, n2, stage, left), STACK_DEPTH of each (depth
+# ≤ log2(n / 64) + 1); the caller gives it as scratch (`stack_for`), for a kernel that allocates
+# nothing loads without numba's array module (numba.np.arrayobj and the modules it imports: about
+# 20 ms of a diagnosis's start, issue 36)
+STACK_DEPTH = 64
+STACK_SIZE = 5 * STACK_DEPTH
+
+
+def stack_for(n_threads: int = 1) -> np.ndarray:
+    """Scratch for `pairwise_sum_into`: one row of `STACK_SIZE` per thread."""
+    return np.empty((max(int(n_threads), 1), STACK_SIZE))
+
+
+def pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """Σ a[lo:lo+n] in numpy's pairwise order (`pairwise_sum_into` with its own scratch)."""
+    return float(pairwise_sum_into(a, lo, n, stack_for()[0]))
+
+
 @jit
-def pairwise_sum(a, lo, n):  # type: ignore[no-untyped-def]
+def pairwise_sum_into(a, lo, n, stack):  # type: ignore[no-untyped-def]
     """Σ a[lo:lo+n] in numpy's pairwise order (`np.add.reduce` along a contiguous float64 axis).
 
     numpy sums a block of ≤ `PW_BLOCKSIZE` terms by `block_sum`, and a longer span as the sum of its
     two halves (the first a multiple of 8 long), recursively. The recursion runs here on an explicit
-    stack (numba's cache cannot reload recursive functions): frame d covers [lo_d, lo_d + n_d),
+    stack (numba's cache cannot reload recursive functions) kept in `stack` (≥ `STACK_SIZE` floats;
+    the frames' integers are held as floats, exact below 2⁵³): frame d covers [lo_d, lo_d + n_d),
     split at n2_d; stage 1 waits for its left half, stage 2 holds it in left_d and waits for the right.
     """
     if n <= PW_BLOCKSIZE:
         return block_sum(a, lo, n)
-    f_lo = np.empty(64, np.int64)  # depth ≤ log2(n / 64) + 1
-    f_n = np.empty(64, np.int64)
-    f_n2 = np.empty(64, np.int64)
-    f_stage = np.empty(64, np.int64)
-    f_left = np.empty(64)
+    f_lo = stack[0:STACK_DEPTH]
+    f_n = stack[STACK_DEPTH : 2 * STACK_DEPTH]
+    f_n2 = stack[2 * STACK_DEPTH : 3 * STACK_DEPTH]
+    f_stage = stack[3 * STACK_DEPTH : 4 * STACK_DEPTH]
+    f_left = stack[4 * STACK_DEPTH : 5 * STACK_DEPTH]
     d = 0
     f_lo[0] = lo
     f_n[0] = n
     while True:
         if f_n[d] > PW_BLOCKSIZE:  # descend into the left half
-            n2 = f_n[d] // 2
+            n2 = int(f_n[d]) // 2
             n2 -= n2 % 8
             f_n2[d] = n2
-            f_stage[d] = 1
+            f_stage[d] = 1.0
             f_lo[d + 1] = f_lo[d]
             f_n[d + 1] = n2
             d += 1
             continue
-        val = block_sum(a, f_lo[d], f_n[d])
+        val = block_sum(a, int(f_lo[d]), int(f_n[d]))
         while True:  # hand val up until a frame still needs its right half
             if d == 0:
                 return val
             d -= 1
-            if f_stage[d] == 1:
+            if f_stage[d] == 1.0:
                 f_left[d] = val
-                f_stage[d] = 2
+                f_stage[d] = 2.0
                 f_lo[d + 1] = f_lo[d] + f_n2[d]
                 f_n[d + 1] = f_n[d] - f_n2[d]
                 d += 1
@@ -179,34 +198,50 @@ def sosfiltfilt_inplace(e, f, pad, sos, zi):  # type: ignore[no-untyped-def]
         biquad_pass(e, f, m - 1, -1, -1, sos[s], zi[s, 0] * ye, zi[s, 1] * ye, zi[s, 0] * yf, zi[s, 1] * yf)
 
 
-@jit
-def sosfiltfilt_one(x, sos, zi, pad, out):  # type: ignore[no-untyped-def]
+def sosfiltfilt_one(x: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int, out: np.ndarray) -> None:
     """``out = sosfiltfilt(sos, x)`` for one signal x (n > pad), serially: the numbers of
     `sosfiltfilt_many`'s rows (paired with a zero signal), without a parallel launch."""
+    sosfiltfilt_one_kernel(x, sos, zi, pad, out, np.zeros((2, x.shape[0] + 2 * pad)))
+
+
+@jit
+def sosfiltfilt_one_kernel(x, sos, zi, pad, out, buf):  # type: ignore[no-untyped-def]
+    """`sosfiltfilt_one` in the caller's zeroed buffer buf (2, n + 2·pad)."""
     n = x.shape[0]
-    buf = np.zeros((2, n + 2 * pad))
-    buf[0, pad : pad + n] = x
+    for k in range(n):  # loops, not slice assignments: those make a load import numba's array module
+        buf[0, pad + k] = x[k]
     sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-    out[:] = buf[0, pad : pad + n]
+    for k in range(n):
+        out[k] = buf[0, pad + k]
 
 
-@jit(parallel=True)
-def sosfiltfilt_many(x, sos, zi, pad, out):  # type: ignore[no-untyped-def]
+def sosfiltfilt_many(x: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int, out: np.ndarray) -> None:
     """``out[r] = sosfiltfilt(sos, x[r])`` for every row r of x (shape (m, n), n > pad), in parallel:
     rows 2q and 2q + 1 on one thread, filtered interleaved (`sosfiltfilt_inplace`); an odd last
     row is paired with a zero signal."""
     m, n = x.shape
+    sosfiltfilt_many_kernel(x, sos, zi, pad, out, np.zeros(((m + 1) // 2, 2, n + 2 * pad)))
+
+
+@jit(parallel=True)
+def sosfiltfilt_many_kernel(x, sos, zi, pad, out, work):  # type: ignore[no-untyped-def]
+    """`sosfiltfilt_many` with the pairs' zeroed buffers work ((m + 1) // 2, 2, n + 2·pad)."""
+    m, n = x.shape
     for q in prange((m + 1) // 2):
         r = 2 * q
         pair = r + 1 < m
-        buf = np.zeros((2, n + 2 * pad))
-        buf[0, pad : pad + n] = x[r]
+        buf = work[q]
+        for k in range(n):
+            buf[0, pad + k] = x[r, k]
         if pair:
-            buf[1, pad : pad + n] = x[r + 1]
+            for k in range(n):
+                buf[1, pad + k] = x[r + 1, k]
         sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-        out[r] = buf[0, pad : pad + n]
+        for k in range(n):
+            out[r, k] = buf[0, pad + k]
         if pair:
-            out[r + 1] = buf[1, pad : pad + n]
+            for k in range(n):
+                out[r + 1, k] = buf[1, pad + k]
 
 
 @jit
@@ -219,47 +254,55 @@ def all_finite(e, lo, hi):  # type: ignore[no-untyped-def]
 
 
 @jit
-def weighted_sum(e, pad, ref, weights):  # type: ignore[no-untyped-def]
-    """Σ weights·(ref − e[pad:len(e)-pad])² in numpy's order (e[:len(e)-2·pad] is overwritten)."""
+def weighted_sum(e, pad, ref, weights, stack):  # type: ignore[no-untyped-def]
+    """Σ weights·(ref − e[pad:len(e)-pad])² in numpy's order (e[:len(e)-2·pad] is overwritten;
+    `stack`: `pairwise_sum_into`'s scratch)."""
     n = e.shape[0] - 2 * pad
     for k in range(n):  # e[k] ← w·r² reads e[pad + k] ≥ k: in place
         r = ref[k] - e[pad + k]
         e[k] = weights[k] * (r * r)
-    return pairwise_sum(e, 0, n)
+    return pairwise_sum_into(e, 0, n, stack)
 
 
 @jit
-def filtered_fitness(e, f, pad, sos, zi, ref, weights):  # type: ignore[no-untyped-def]
+def filtered_fitness(e, f, pad, sos, zi, ref, weights, stack):  # type: ignore[no-untyped-def]
     """eq. (3) of the currents x = e[pad:len(e)-pad] and the same in f (unfiltered; both are
     overwritten): the filter of `sosfiltfilt_inplace`, then Σ weights·(ref − filtered x)² in
-    numpy's order. NaN for a current that is not finite."""
+    numpy's order (`stack`: `pairwise_sum_into`'s scratch). NaN for a current that is not finite."""
     n = e.shape[0] - 2 * pad
     finite_e = all_finite(e, pad, pad + n)
     finite_f = all_finite(f, pad, pad + n)
     sosfiltfilt_inplace(e, f, pad, sos, zi)
-    fit_e = weighted_sum(e, pad, ref, weights) if finite_e else np.nan
-    fit_f = weighted_sum(f, pad, ref, weights) if finite_f else np.nan
+    fit_e = weighted_sum(e, pad, ref, weights, stack) if finite_e else np.nan
+    fit_f = weighted_sum(f, pad, ref, weights, stack) if finite_f else np.nan
     return fit_e, fit_f
 
 
 @jit
-def simulate_pair(theta_cmd, prm, r, pair, pad):  # type: ignore[no-untyped-def]
-    """LF runs of rows r and, with `pair`, r + 1 of `prm` into a new buffer of 2 rows of
-    len(theta_cmd) + 2·pad samples, each current at [pad, pad + n) (the pads are the filter's to
-    fill); without `pair` the second row is zeros (a partner for the interleaved filter)."""
+def simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux):  # type: ignore[no-untyped-def]
+    """LF runs of rows r and, with `pair`, r + 1 of `prm` into buf (2 rows of len(theta_cmd) + 2·pad
+    samples), each current at [pad, pad + n) (the pads are the filter's to fill); without `pair`
+    the second row is zeros (a partner for the interleaved filter). no_aux: an empty (0, N_AUX)."""
     n = theta_cmd.shape[0]
-    no_aux = np.empty((0, N_AUX))
-    buf = np.empty((2, n + 2 * pad))
     if pair:  # the two runs interleaved (`simulate_lf2`: the same currents, to the bit)
-        simulate_lf2(theta_cmd, prm[r], prm[r + 1], buf[0, pad : pad + n], buf[1, pad : pad + n])
+        simulate_lf2(theta_cmd, prm[r], prm[r + 1], buf[0, pad : pad + n], buf[1, pad : pad + n], no_aux)
     else:
         simulate_lf(theta_cmd, prm[r], buf[0, pad : pad + n], no_aux)
-        buf[1, :] = 0.0
-    return buf
+        for k in range(buf.shape[1]):
+            buf[1, k] = 0.0
 
 
-@jit(parallel=True)
-def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads):  # type: ignore[no-untyped-def]
+def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
+    """What a fused kernel's call takes besides its data: the batch's plan (`batches.batch_plan`),
+    a buffer of 2 × (n + 2·pad) and `pairwise_sum_into`'s scratch per thread. Allocated here, not in
+    the kernels: a kernel that allocates loads with numba's array module (`STACK_SIZE`'s note)."""
+    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
+    threads = max(int(n_threads), 1)
+    return owner, n_pairs, np.empty((threads, 2, n + 2 * pad)), stack_for(threads)
+
+
+def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
+                    ref: np.ndarray, weights: np.ndarray, out: np.ndarray, n_threads: int) -> None:  # fmt: skip
     """eq. (3) of one LF run per row of `prm` (shape (n_runs, N_FIELDS)) into out (n_runs,), in parallel.
 
     = Σ weights·(ref − sosfiltfilt(sos, simulate_lf(row)))² per row; ref and weights have the
@@ -269,20 +312,29 @@ def fitness_lf_many(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads):
     filtered beside a zero signal. `n_threads`: the threads numba runs it on
     (``numba.get_num_threads()``; a kernel that asks numba itself cannot be cached).
     """
-    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
+    owner, n_pairs, work, stacks = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, NO_AUX)
+
+
+@jit(parallel=True)
+def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, no_aux):  # type: ignore[no-untyped-def]
+    """`fitness_lf_many` with its plan and buffers (`_buffers`): thread t runs the tasks
+    owner gives it in work[t], with stacks[t]."""
     for t in prange(max(n_threads, 1)):  # the plan's threads are 0 … max(n_threads, 1) − 1
+        buf = work[t]
         for task in range(owner.shape[0]):
             if owner[task] == t:
                 r, pair = planned_task(task, n_pairs)
-                buf = simulate_pair(theta_cmd, prm, r, pair, pad)
-                fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights)
+                simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux)
+                fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
                 out[r] = fit_0
                 if pair:
                     out[r + 1] = fit_1
 
 
-@jit(parallel=True)
-def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads):  # type: ignore[no-untyped-def]
+def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
+                      keep: np.ndarray, ref_keep: np.ndarray, root_w: np.ndarray, out: np.ndarray,
+                      n_threads: int) -> None:  # fmt: skip
     """eq. (3)'s residual vector of one LF run per row of `prm` into out (n_runs, len(keep)), in
     parallel: out[r] = root_w·(ref_keep − sosfiltfilt(sos, simulate_lf(row))[keep]).
 
@@ -293,12 +345,19 @@ def residuals_lf_many(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out,
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
     LF current is not finite gets NaN residuals. `n_threads` as in `fitness_lf_many`.
     """
-    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
+    owner, n_pairs, work, _ = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, NO_AUX)
+
+
+@jit(parallel=True)
+def residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, no_aux):  # type: ignore[no-untyped-def]
+    """`residuals_lf_many` with its plan and buffers (`_buffers`)."""
     for t in prange(max(n_threads, 1)):
+        buf = work[t]
         for task in range(owner.shape[0]):
             if owner[task] == t:
                 r, pair = planned_task(task, n_pairs)
-                buf = simulate_pair(theta_cmd, prm, r, pair, pad)
+                simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux)
                 sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
                 kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
                 if pair:

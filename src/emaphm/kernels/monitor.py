@@ -66,6 +66,9 @@ N_FIELDS = len(LF_FIELDS)
 
 AUX_COLUMNS = ("theta_u", "theta_m", "omega_m", "theta_e", "i_q_ref", "T_m")
 N_AUX = len(AUX_COLUMNS)
+# no auxiliary output (`simulate_lf`'s aux with no rows), made here and passed in: a kernel that
+# allocates it loads with numba's array module (kernels.fitness, STACK_SIZE's note)
+NO_AUX = np.empty((0, N_AUX))
 
 (F_S, F_D, B, N_A, N_B, N_C, ZETA, PHI_E, K_P, J, C, TAU, ETA, THETA_MAX, T_LOAD, K_I, K_D, TAU_D, I_MAX, T_S,
  LSB_THETA, FS_THETA, P, K_FT, K_FS, K_E, K_T_EQ, K_E_EQ, R_EQ, L_EQ, TAU_I, U_MAX, ECC_COUPLING,
@@ -411,8 +414,9 @@ def simulate_lf(theta_cmd, prm, i_out, aux):  # type: ignore[no-untyped-def]
 
 
 @jit
-def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-untyped-def]
-    """`simulate_lf` of two rows at once, their steps interleaved, into out_a and out_b (no aux).
+def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b, no_aux):  # type: ignore[no-untyped-def]
+    """`simulate_lf` of two rows at once, their steps interleaved, into out_a and out_b (no aux;
+    no_aux: an empty (0, `N_AUX`) array, `NO_AUX`).
 
     One step is a chain of dependent operations (sin and cos of θ_e, the loop, tanh, the
     friction's divisions, back to θ_m) whose latency, not the core's throughput, sets its time;
@@ -421,7 +425,6 @@ def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-unty
     with other steps per sample (n_lf) run one after the other.
     """
     n = theta_cmd.shape[0]
-    no_aux = np.empty((0, N_AUX))
     ca = lf_constants(prm_a)
     cb = lf_constants(prm_b)
     n_lf = ca[2]
@@ -464,13 +467,17 @@ def simulate_lf2(theta_cmd, prm_a, prm_b, out_a, out_b):  # type: ignore[no-unty
 PAIR_MIN_ROWS = 4
 
 
-@jit(parallel=True)
-def simulate_lf_many(theta_cmd, prm, i_out):  # type: ignore[no-untyped-def]
+def simulate_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, i_out: np.ndarray) -> None:
     """One LF run per row of `prm` (shape (n_runs, N_FIELDS)) into i_out (shape (n_runs, n)), in
     parallel: in interleaved pairs (`simulate_lf2`) from `PAIR_MIN_ROWS` rows, else one row per
     thread (two rows as a pair would leave the second thread idle). Each row's current is
     `simulate_lf`'s, to the bit."""
-    no_aux = np.empty((0, N_AUX))
+    simulate_lf_many_kernel(theta_cmd, prm, i_out, NO_AUX)
+
+
+@jit(parallel=True)
+def simulate_lf_many_kernel(theta_cmd, prm, i_out, no_aux):  # type: ignore[no-untyped-def]
+    """`simulate_lf_many` (no_aux: `NO_AUX`)."""
     n_runs = prm.shape[0]
     if n_runs < PAIR_MIN_ROWS:
         for r in prange(n_runs):
@@ -479,6 +486,6 @@ def simulate_lf_many(theta_cmd, prm, i_out):  # type: ignore[no-untyped-def]
     for q in prange((n_runs + 1) // 2):
         r = 2 * q
         if r + 1 < n_runs:
-            simulate_lf2(theta_cmd, prm[r], prm[r + 1], i_out[r], i_out[r + 1])
+            simulate_lf2(theta_cmd, prm[r], prm[r + 1], i_out[r], i_out[r + 1], no_aux)
         else:
             simulate_lf(theta_cmd, prm[r], i_out[r], no_aux)

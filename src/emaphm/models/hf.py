@@ -15,7 +15,7 @@ from ..kernels.foc import FocPack
 from ..kernels.hf_twin import N_OUT, OUT_COLUMNS, simulate_hf
 from ..kernels.pmsm_abc import StatorPack, stator_pack
 from ..kernels.sensors import adc
-from ..kernels.transforms import clarke, park
+from ..kernels.transforms import q_error
 from ..params import EmaParams
 from ..results import SimResult
 from ._base import _EmaModel, check_finite, check_seed, controller_pack, mechanics_pack
@@ -173,8 +173,8 @@ class HighFidelityEma(_EmaModel):
         measured = np.empty((3, n))
         for j, name in enumerate(("i_a", "i_b", "i_c")):
             adc(col[name], current_noise[j], sens.lsb_current, sens.full_scale_current, measured[j])
-        err_alpha, err_beta = clarke(*(measured - np.stack([col["i_a"], col["i_b"], col["i_c"]])))
-        i_q = col["i_q"] + park(err_alpha, err_beta, col["theta_e"])[1]
+        i_q = np.empty(n)
+        q_error(*(measured - np.stack([col["i_a"], col["i_b"], col["i_c"]])), col["theta_e"], col["i_q"], i_q)
 
         signals = {
             "theta_cmd": theta_cmd,
