@@ -14,7 +14,9 @@ Prints, each as the median (min-max) over --repeats:
 4. the fused residual kernel per batch size on two threads, random rows against the Table 1
    case's recording, with the batch plan (`kernels.batches`);
 5. the monitor's parameter rows for 8 fault rows: built whole (`lf.monitor_rows`) and from the
-   monitor's template row (`MonitorEma.rows`).
+   monitor's template row (`MonitorEma.rows`);
+6. (fifteenth session) one monitor run (`monitor.simulate_lf`) and an interleaved pair
+   (`simulate_lf2`) of the Table 1 case's row over the chirp's 10 001 samples, on one thread.
 Run on an older tree (``PYTHONPATH=<worktree>/src``) it times what that tree has: no events'
 block, no `gram`, the fused kernel without its thread count (then its pairs alone).
 Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
@@ -23,6 +25,7 @@ Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
 from __future__ import annotations
 
 import argparse
+import functools
 import inspect
 import os
 import pickle
@@ -61,6 +64,17 @@ print(time.perf_counter() - t)
 def spread(values: list[float], scale: float = 1e3) -> str:
     v = np.asarray(values) * scale
     return f"{np.median(v):.2f} ({v.min():.2f}-{v.max():.2f})"
+
+
+def per_call(way, repeats: int, calls: int) -> list[float]:  # type: ignore[no-untyped-def]
+    """`repeats` times, the mean time of one of `calls` calls of `way()` [s]."""
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        for _ in range(calls):
+            way()
+        times.append((time.perf_counter() - t) / calls)
+    return times
 
 
 def fresh(code: str, *args: str) -> list[str]:
@@ -109,13 +123,7 @@ def main(argv: list[str] | None = None) -> None:
     if hasattr(lm_descent, "gram"):
         ways["gram"] = lambda: lm_descent.gram(Jt)
     for name, way in ways.items():
-        times = []
-        for _ in range(args.repeats):
-            t = time.perf_counter()
-            for _ in range(100):
-                way()
-            times.append((time.perf_counter() - t) / 100)
-        print(f"3. J^T J of 8 x 10 001 by {name}: {spread(times)} ms")
+        print(f"3. J^T J of 8 x 10 001 by {name}: {spread(per_call(way, args.repeats, 100))} ms")
     monitor = emaphm.MonitorEma()
     trace = emaphm.HighFidelityEma().simulate(TABLE1, seed=1)
     fit = Fitness(Comparison.from_signal(trace.t, trace.i_q, monitor.params.controller.f_s))
@@ -125,12 +133,8 @@ def main(argv: list[str] | None = None) -> None:
     threads = ((2,) if "n_threads" in inspect.signature(getattr(residuals_lf_many, "py_func", residuals_lf_many)).parameters else ())
     for n in (1, 2, 4, 6, 8, 9, 18):
         rows, out = monitor.rows(K[:n]), np.empty((n, len(keep)))
-        times = []
-        for _ in range(args.repeats):
-            t = time.perf_counter()
-            for _ in range(10):
-                residuals_lf_many(theta_cmd, rows, fit.sos, fit.zi, fit.padlen, keep, reference, root_w, out, *threads)
-            times.append((time.perf_counter() - t) / 10)
+        times = per_call(functools.partial(residuals_lf_many, theta_cmd, rows, fit.sos, fit.zi, fit.padlen, keep,
+                                           reference, root_w, out, *threads), args.repeats, 10)  # fmt: skip
         print(f"4. the fused residual kernel, {n} rows on 2 threads: {spread(times)} ms")
     from emaphm.models.lf import monitor_rows
 
@@ -138,13 +142,16 @@ def main(argv: list[str] | None = None) -> None:
     ways = {"monitor_rows": lambda: monitor_rows(K[:8], monitor.params, [cal.coefficients], cal.n_lf, cal.monitor),
             "MonitorEma.rows": lambda: monitor.rows(K[:8])}  # fmt: skip
     for name, way in ways.items():
-        times = []
-        for _ in range(args.repeats):
-            t = time.perf_counter()
-            for _ in range(1000):
-                way()
-            times.append((time.perf_counter() - t) / 1000)
-        print(f"5. 8 parameter rows by {name}: {spread(times, 1e6)} us")
+        print(f"5. 8 parameter rows by {name}: {spread(per_call(way, args.repeats, 1000), 1e6)} us")
+    from emaphm.kernels.monitor import N_AUX, simulate_lf, simulate_lf2
+
+    row = monitor.rows(np.array([TABLE1]))[0]
+    no_aux, a, b = np.empty((0, N_AUX)), np.empty(len(theta_cmd)), np.empty(len(theta_cmd))
+    pair_args = (no_aux,) if "no_aux" in inspect.signature(simulate_lf2.py_func).parameters else ()
+    runs = {"one run": lambda: simulate_lf(theta_cmd, row, a, no_aux),
+            "an interleaved pair": lambda: simulate_lf2(theta_cmd, row, row, a, b, *pair_args)}  # fmt: skip
+    for name, way in runs.items():
+        print(f"6. the monitor, {name}: {spread(per_call(way, args.repeats, 50))} ms")
 
 
 if __name__ == "__main__":
