@@ -100,8 +100,9 @@ def identify(
     """
     import json
 
-    from ..identification.api import identify as run_identify
     from ..io import atomic_path
+
+    run_identify = _imported_identify()
 
     settings = settings_from_options(options)
     if baseline is not None:  # its files stand for these options: refused beside it, or missing, now
@@ -217,3 +218,13 @@ def _checked_inputs(
 
         load_factors(uq_calibration)  # a bad file: refused before the work
     return truth, thresholds
+
+
+def _imported_identify() -> Any:
+    """`api.identify`, imported; then the collector settled (`emaphm._gc.settled`: the imports'
+    objects frozen out of later collections, the thresholds back)."""
+    from .._gc import settled
+    from ..identification.api import identify
+
+    settled()
+    return identify
