@@ -16,7 +16,10 @@ Prints, each as the median (min-max) over --repeats:
 5. the monitor's parameter rows for 8 fault rows: built whole (`lf.monitor_rows`) and from the
    monitor's template row (`MonitorEma.rows`);
 6. (fifteenth session) one monitor run (`monitor.simulate_lf`) and an interleaved pair
-   (`simulate_lf2`) of the Table 1 case's row over the chirp's 10 001 samples, on one thread.
+   (`simulate_lf2`) of the Table 1 case's row over the chirp's 10 001 samples, on one thread;
+7. (fifteenth session) the cyclic collector's work in one ``emaphm identify <Table 1>`` process
+   (``gc.callbacks``, from the process's entry to its end), with the start's raised threshold
+   (`emaphm._gc`) and without it (`quiet_start` made a no-op), where the tree has it.
 Run on an older tree (``PYTHONPATH=<worktree>/src``) it times what that tree has: no events'
 block, no `gram`, the fused kernel without its thread count (then its pairs alone).
 Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
@@ -50,6 +53,33 @@ t = time.perf_counter()
 for k, s in sigs:
     k.compile(s)
 print(time.perf_counter() - t, len(sigs))
+"""
+
+COLLECTOR = """
+import gc, os, sys, time
+n, spent, t0 = [0, 0, 0], [0.0], [0.0]
+def watch(phase, info):
+    if phase == "start":
+        t0[0] = time.perf_counter()
+    else:
+        n[info["generation"]] += 1
+        spent[0] += time.perf_counter() - t0[0]
+gc.callbacks.append(watch)
+end = os._exit
+def report(status):
+    print(spent[0], *n)
+    sys.stdout.flush()
+    end(status)
+os._exit = report
+if sys.argv[1] == "off":
+    try:
+        import emaphm._gc
+        emaphm._gc.quiet_start = lambda: None
+    except ImportError:
+        pass
+sys.argv = ["emaphm", "identify", "--true-faults", "0.2383,0.5003,0,0.4503,0.0404,0.0028,0.2785,0.5", "--seed", "1"]
+from emaphm.cli import main
+main()
 """
 
 MOOCORE = """
@@ -152,6 +182,11 @@ def main(argv: list[str] | None = None) -> None:
             "an interleaved pair": lambda: simulate_lf2(theta_cmd, row, row, a, b, *pair_args)}  # fmt: skip
     for name, way in runs.items():
         print(f"6. the monitor, {name}: {spread(per_call(way, args.repeats, 50))} ms")
+    for mode in ("on", "off"):
+        runs = [fresh(COLLECTOR, mode)[-4:] for _ in range(args.repeats)]
+        counts = "/".join(str(int(np.median([int(r[g]) for r in runs]))) for g in (1, 2, 3))
+        print(f"7. the collector in an identify process, the start's threshold {mode}: "
+              f"{spread([float(r[0]) for r in runs])} ms, collections young/middle/full {counts} (medians)")
 
 
 if __name__ == "__main__":
