@@ -23,7 +23,6 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import get_num_threads
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
@@ -97,7 +96,7 @@ class Fitness:
         self._check_grid(len(theta_cmd))
         keep, root_w, reference = self.weighed()
         out = np.empty((rows.shape[0], len(keep)))
-        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, reference, root_w, out, get_num_threads())
+        residuals_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, keep, reference, root_w, out)
         return out
 
     def weighed(self) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
@@ -144,5 +143,5 @@ class Fitness:
         ref = self.comparison.reference
         self._check_grid(len(theta_cmd))
         out = np.empty(rows.shape[0])
-        fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out, get_num_threads())
+        fitness_lf_many(theta_cmd, rows, self.sos, self.zi, self.padlen, ref, self.weights, out)
         return out

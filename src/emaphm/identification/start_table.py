@@ -40,7 +40,6 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import get_num_threads
 from numpy.typing import NDArray
 
 from ..callbacks import Progress
@@ -165,7 +164,7 @@ def build_table(
         rows = monitor.rows(search_to_faults(X[start : start + BUILD_BATCH]))
         out = np.empty((rows.shape[0], len(index)))
         # residuals against a zero reference with unit weights: −(the filtered current) at `index`
-        residuals_lf_many(theta_cmd, rows, fitness.sos, fitness.zi, fitness.padlen, index, zeros, ones, out, get_num_threads())
+        residuals_lf_many(theta_cmd, rows, fitness.sos, fitness.zi, fitness.padlen, index, zeros, ones, out)
         T[start : start + len(rows)] = -out
         if on_progress is not None:
             on_progress("start table (once per actuator and command)", start + len(rows), TABLE_ROWS)

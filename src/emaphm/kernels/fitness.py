@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
+from numba import get_num_threads, prange
 
 from ._jit import jit
 from .batches import batch_plan, planned_task
@@ -292,27 +292,30 @@ def simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux):  # type: ignore[no
             buf[1, k] = 0.0
 
 
-def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
-    """What a fused kernel's call takes besides its data: the batch's plan (`batches.batch_plan`),
-    a buffer of 2 × (n + 2·pad) and `pairwise_sum_into`'s scratch per thread. Allocated here, not in
-    the kernels: a kernel that allocates loads with numba's array module (`STACK_SIZE`'s note)."""
+def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int | None) -> tuple[int, np.ndarray, int, np.ndarray]:
+    """What a fused kernel's call takes besides its data: the thread count (default numba's,
+    ``numba.get_num_threads()``, asked here: a kernel that asks numba itself cannot be cached), the
+    batch's plan (`batches.batch_plan`) and a buffer of 2 × (n + 2·pad) per thread. Allocated
+    here, not in the kernels: a kernel that allocates loads with numba's array module
+    (`STACK_SIZE`'s note)."""
+    n_threads = get_num_threads() if n_threads is None else int(n_threads)
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
-    threads = max(int(n_threads), 1)
-    return owner, n_pairs, np.empty((threads, 2, n + 2 * pad)), stack_for(threads)
+    return n_threads, owner, n_pairs, np.empty((max(n_threads, 1), 2, n + 2 * pad))
 
 
 def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
-                    ref: np.ndarray, weights: np.ndarray, out: np.ndarray, n_threads: int) -> None:  # fmt: skip
+                    ref: np.ndarray, weights: np.ndarray, out: np.ndarray, n_threads: int | None = None) -> None:  # fmt: skip
     """eq. (3) of one LF run per row of `prm` (shape (n_runs, N_FIELDS)) into out (n_runs,), in parallel.
 
     = Σ weights·(ref − sosfiltfilt(sos, simulate_lf(row)))² per row; ref and weights have the
     length of theta_cmd; zi = sosfilt_zi(sos); pad = sosfiltfilt's default padlen. The rows go in
     pairs (rows 2q and 2q + 1 on one thread) whose filters run interleaved, some rows alone where
     that shares the batch better among the threads (`batches.batch_plan`); a row alone is
-    filtered beside a zero signal. `n_threads`: the threads numba runs it on
-    (``numba.get_num_threads()``; a kernel that asks numba itself cannot be cached).
+    filtered beside a zero signal. `n_threads`: the threads numba runs it on (default
+    ``numba.get_num_threads()``).
     """
-    owner, n_pairs, work, stacks = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    n_threads, owner, n_pairs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    stacks = stack_for(n_threads)
     fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, NO_AUX)
 
 
@@ -334,7 +337,7 @@ def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads
 
 def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
                       keep: np.ndarray, ref_keep: np.ndarray, root_w: np.ndarray, out: np.ndarray,
-                      n_threads: int) -> None:  # fmt: skip
+                      n_threads: int | None = None) -> None:  # fmt: skip
     """eq. (3)'s residual vector of one LF run per row of `prm` into out (n_runs, len(keep)), in
     parallel: out[r] = root_w·(ref_keep − sosfiltfilt(sos, simulate_lf(row))[keep]).
 
@@ -345,7 +348,7 @@ def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, z
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
     LF current is not finite gets NaN residuals. `n_threads` as in `fitness_lf_many`.
     """
-    owner, n_pairs, work, _ = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    n_threads, owner, n_pairs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
     residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, NO_AUX)
 
 
