@@ -301,10 +301,10 @@ def lf_constants(prm):  # type: ignore[no-untyped-def]
 
 
 # The electrical angle's sine and cosine are carried from step to step and rotated through the
-# step's angle d = p·(θ_m,new − θ_m) (`advance_angle`): sin and cos of libm were about a quarter of a
-# step's time (issue 36, fifteenth session). The series below are exact to rounding up to
-# ROTATION_MAX (the first terms left out, d¹³/13! and d¹⁴/14!, are below 2e-18 there; a 100 µs step
-# turned θ_e by at most 0.06 rad in 30 random runs of the chirp); a larger turn (an end-stop's jump)
+# step's angle d = p·(θ_m,new − θ_m) (`advance_angle`), instead of libm's sin and cos at every step
+# (with the drive train's divisions hoisted, a run 25-29 % faster: `studies/step_timings.py` item 6,
+# issue 36, fifteenth session). The series below are exact to rounding up to ROTATION_MAX (the first
+# terms left out, d¹³/13! and d¹⁴/14!, are below 2e-18 there); a larger turn (an end-stop's jump)
 # and every ANGLE_RESYNC-th step take libm's values afresh, so rounding cannot accumulate.
 ROTATION_MAX = 0.2
 ANGLE_RESYNC = 32
