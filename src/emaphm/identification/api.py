@@ -82,7 +82,7 @@ def identify(
     actuator, monitor, factors = _inputs(s, params, calibration, uq_calibration)
     start = time.perf_counter()
     noise_seed, opt_seed = split_seed(s.seed)
-    m = divided_by_gain(measurement(true_faults, reference, channel_map, actuator, noise_seed), used)
+    m = divided_by_gain(measurement(true_faults, reference, channel_map, actuator, noise_seed, monitor), used)
     doubtful = fit_limit(_fit_record(s, factors, uq_calibration, monitor), monitor.monitor)
     balanced = allowance(params, used is not None)  # ψ_m's share of the shorts (`uncertainty.balanced`)
     ident = FaultIdentifier(s.replace(seed=opt_seed), monitor=monitor, on_generation=on_generation,

@@ -15,10 +15,10 @@ from ..errors import InputError
 from ..faults import as_fault_vector
 from ..io import read_trace
 from ..measured.checks import plausibility
-from ..models import HighFidelityEma
+from ..models import HighFidelityEma, MonitorEma
 from ..params import EmaParams
 from ..results import SimResult
-from . import limits
+from . import limits, warm
 
 __all__ = ["Measurement", "measurement", "split_seed"]
 
@@ -46,10 +46,17 @@ class Measurement:
 
 
 def measurement(
-    true_faults: ArrayLike | None, reference: Any, channel_map: Any, actuator: EmaParams, noise_seed: int
+    true_faults: ArrayLike | None,
+    reference: Any,
+    channel_map: Any,
+    actuator: EmaParams,
+    noise_seed: int,
+    monitor: MonitorEma | None = None,
 ) -> Measurement:
     """The twin run with `true_faults` (noise on, `noise_seed`), or `reference` (a trace file or
-    `SimResult`, or with `channel_map` a rig's recording) checked: exactly one of the two."""
+    `SimResult`, or with `channel_map` a rig's recording) checked: exactly one of the two. Given
+    the `monitor` the search will run, the twin's run goes on a thread while this one loads the
+    search's kernels (`warm`)."""
     if (true_faults is None) == (reference is None):
         raise InputError("give exactly one of true faults or a reference trace")
     if channel_map is not None and reference is None:
@@ -58,7 +65,13 @@ def measurement(
         )
     if true_faults is not None:
         truth = as_fault_vector(true_faults, name="true faults")
-        trace = HighFidelityEma(actuator, Chirp()).simulate(truth, noise=True, seed=noise_seed)
+        twin = HighFidelityEma(actuator, Chirp())
+        if monitor is None:
+            trace = twin.simulate(truth, noise=True, seed=noise_seed)
+        else:
+            twin.simulate(truth, noise=True, seed=noise_seed, duration=warm.TWIN_SPAN_S)  # its kernels loaded
+            trace = warm.meanwhile(lambda: twin.simulate(truth, noise=True, seed=noise_seed),
+                                   lambda: warm.load_search_kernels(monitor))  # fmt: skip
         return Measurement(trace, Chirp(), truth, "HF twin, noise on")
     conversion = None
     if channel_map is not None:

@@ -1,0 +1,63 @@
+"""The search's kernels loaded while the twin measures (issue 36).
+
+A fresh process loads each compiled kernel from numba's cache when it is first called: the
+twin's with numba's own start, then, inside the search, the monitor's, the comparison filter's
+and the fused fitness kernels' (about 35 ms on machine G, `studies/step_timings.py` item 1). The
+twin's run that makes the measurement (`recording.measurement`, ~30 ms at 1 µs) holds neither
+the interpreter nor numba's compiler (its kernel is ``nogil``) and keeps one core busy; the other
+one waited. So when the twin measures, its kernels are loaded first by a run over `TWIN_SPAN_S`,
+the whole run goes on a thread, and meanwhile `load_search_kernels` loads the search's by calls
+on a short synthetic recording through the same Python paths the search takes: the same
+signatures, so the search loads nothing more (tests/identification/test_warm.py). The
+measurement and the search are unchanged: only when the loads happen moves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import TYPE_CHECKING, TypeVar
+
+import numpy as np
+
+from ..faults import HEALTHY
+
+if TYPE_CHECKING:
+    from ..models import MonitorEma
+
+__all__ = ["LOAD_SPAN_S", "TWIN_SPAN_S", "load_search_kernels", "meanwhile"]
+
+T = TypeVar("T")
+
+LOAD_SPAN_S = 0.05  # the synthetic recording's span [s]: 500 samples at 10 kHz, the filter needs > 9
+TWIN_SPAN_S = 0.002  # the twin's run that loads its kernels [s]
+
+
+def load_search_kernels(monitor: MonitorEma) -> None:
+    """Call, on a synthetic recording of `LOAD_SPAN_S` (a ramp of current), every kernel the search
+    calls through its own Python path: the fused fitness and residual kernels (`Fitness`), the
+    monitor's runs alone and as a population, and the comparison filter on one and on several
+    signals. Their numbers are thrown away."""
+    from .fitness import Fitness
+    from .signals import Comparison
+
+    t, _ = monitor.sample_grid(LOAD_SPAN_S)
+    # any current that is not constant, writable as a measured one (a read-only array is another signature)
+    comparison = Comparison.from_signal(t, np.array(t), monitor.params.controller.f_s)
+    fitness = Fitness(comparison)
+    K = np.array([HEALTHY, HEALTHY])
+    fitness.of_monitor(monitor, K, duration=LOAD_SPAN_S)
+    fitness.residuals_of_monitor(monitor, K, duration=LOAD_SPAN_S)
+    monitor.simulate(HEALTHY, duration=LOAD_SPAN_S)
+    monitor.simulate_many(K, duration=LOAD_SPAN_S, check=False)
+    comparison.filtered(np.zeros(len(t)))
+    comparison.filtered(np.zeros((2, len(t))))
+
+
+def meanwhile(work: Callable[[], T], other: Callable[[], None]) -> T:
+    """`work()` on a thread while `other()` runs on this one; `work`'s result (or its exception,
+    raised here once `other` is done)."""
+    with ThreadPoolExecutor(1, thread_name_prefix="emaphm-measure") as pool:
+        pending = pool.submit(work)
+        other()
+        return pending.result()
