@@ -20,6 +20,10 @@ Prints, each as the median (min-max) over --repeats:
 7. (fifteenth session) the cyclic collector's work in one ``emaphm identify <Table 1>`` process
    (``gc.callbacks``, from the process's entry to its end), with the start's raised threshold
    (`emaphm._gc`) and without it (`quiet_start` made a no-op), where the tree has it.
+8. (sixteenth session) the switching model's twin runs (`last_stage.SwitchingModel`, the Table 1
+   case): each of its three runs alone, the three one after the other, the three on two threads
+   as the last stage runs them, and one run (the finest step) alone against two of it side by
+   side on two threads: what the two cores give two runs of compiled code at once.
 Run on an older tree (``PYTHONPATH=<worktree>/src``) it times what that tree has: no events'
 block, no `gram`, the fused kernel without its thread count (then its pairs alone).
 Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
@@ -182,11 +186,37 @@ def main(argv: list[str] | None = None) -> None:
             "an interleaved pair": lambda: simulate_lf2(theta_cmd, row, row, a, b, *pair_args)}  # fmt: skip
     for name, way in runs.items():
         print(f"6. the monitor, {name}: {spread(per_call(way, args.repeats, 50))} ms")
+    switching_runs(args.repeats)
     for mode in ("on", "off"):
         runs = [fresh(COLLECTOR, mode)[-4:] for _ in range(args.repeats)]
         counts = "/".join(str(int(np.median([int(r[g]) for r in runs]))) for g in (1, 2, 3))
         print(f"7. the collector in an identify process, the start's threshold {mode}: "
               f"{spread([float(r[0]) for r in runs])} ms, collections young/middle/full {counts} (medians)")
+
+
+
+def switching_runs(repeats: int) -> None:
+    """Item 8: the switching model's twin runs alone, in turn, on two threads, and side by side."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from emaphm.commands import Chirp
+    from emaphm.identification.last_stage import SwitchingModel
+    from emaphm.params import EmaParams
+
+    model = SwitchingModel(EmaParams(), Chirp())
+    k = np.array(TABLE1)
+    runs = [functools.partial(m.simulate, k, noise=False, duration=1.0) for m in model.models]
+    for run in runs:
+        run()  # loaded
+    for step, run in zip(model.steps, runs, strict=True):
+        print(f"8. the twin at {step * 1e6:g} us, one run: {spread(per_call(run, repeats, 3))} ms")
+    print(f"8. the three in turn: {spread(per_call(lambda: [r() for r in runs], repeats, 1))} ms")
+    three = functools.partial(model.current, k, duration=1.0, workers=2)
+    print(f"8. the three on two threads (SwitchingModel.current): {spread(per_call(three, repeats, 1))} ms")
+    finest = runs[int(np.argmin(model.steps))]
+    with ThreadPoolExecutor(2) as pool:
+        pair = per_call(lambda: list(pool.map(lambda _: finest(), range(2))), repeats, 1)
+    print(f"8. the finest step's run, two side by side on two threads: {spread(pair)} ms")
 
 
 if __name__ == "__main__":
