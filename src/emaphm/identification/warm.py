@@ -2,14 +2,16 @@
 
 A fresh process loads each compiled kernel from numba's cache when it is first called: the
 twin's with numba's own start, then, inside the search, the monitor's, the comparison filter's
-and the fused fitness kernels' (about 35 ms on machine G, `studies/step_timings.py` item 1). The
-twin's run that makes the measurement (`recording.measurement`, ~30 ms at 1 µs) holds neither
-the interpreter nor numba's compiler (its kernel is ``nogil``) and keeps one core busy; the other
-one waited. So when the twin measures, its kernels are loaded first by a run over `TWIN_SPAN_S`,
-the whole run goes on a thread, and meanwhile `load_search_kernels` loads the search's by calls
-on a short synthetic recording through the same Python paths the search takes: the same
-signatures, so the search loads nothing more (tests/identification/test_warm.py). The
-measurement and the search are unchanged: only when the loads happen moves.
+and the fused fitness kernels' (together 56 ms on machine G, `studies/step_timings.py` item 1).
+The twin's run that makes the measurement (`recording.measurement`; 0.05 s per simulated second
+of the Table 1 case, `benchmarks/bench_hf.py`) holds neither the interpreter nor numba's compiler
+(its kernel is ``nogil``) and keeps one core busy while the other waited. So when the twin
+measures, its kernels are loaded first by a run over `TWIN_SPAN_S`, the whole run goes on a
+thread, and meanwhile `load_search_kernels` loads the search's by calls on a short synthetic
+recording through the same Python paths the search takes: the same signatures, so the search
+loads nothing more (tests/identification/test_warm.py). The measurement and the search are
+unchanged: only when the loads happen moves (0.959x the Table 1 case's time from the shell,
+BENCHMARKS.md, issue 36, sixteenth session).
 """
 
 from __future__ import annotations
