@@ -44,7 +44,8 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     from .signals import Comparison
 
     t, _ = monitor.sample_grid(LOAD_SPAN_S)
-    # any current that is not constant, writable as a measured one (a read-only array is another signature)
+    # any current that is not constant, writable as a measured one (a read-only array is another
+    # signature); filtering it is the comparison filter's call on one signal
     comparison = Comparison.from_signal(t, np.array(t), monitor.params.controller.f_s)
     fitness = Fitness(comparison)
     K = np.array([HEALTHY, HEALTHY])
@@ -52,7 +53,6 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     fitness.residuals_of_monitor(monitor, K, duration=LOAD_SPAN_S)
     monitor.simulate(HEALTHY, duration=LOAD_SPAN_S)
     monitor.simulate_many(K, duration=LOAD_SPAN_S, check=False)
-    comparison.filtered(np.zeros(len(t)))
     comparison.filtered(np.zeros((2, len(t))))
 
 
