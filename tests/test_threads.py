@@ -146,3 +146,23 @@ def test_thread_map_starts_the_costliest_first_and_returns_in_the_items_order():
     assert thread_map(run, items, 2) == ["A", "B", "C"] and started[-1] == "c"  # no costs: in order
     with pytest.raises(InputError, match="costs has 2 values for 3 items"):
         thread_map(run, items, 2, costs=[1.0, 2.0])
+
+
+RUNTIME = """
+from numba.core.runtime import rtsys
+from emaphm._threads import runtime_meanwhile
+before = rtsys._init
+thread = runtime_meanwhile()
+thread.join()
+from emaphm import MonitorEma
+current = MonitorEma().simulate([0.1] * 7 + [0.5], duration=0.05).i_q
+print(before, rtsys._init, thread.name, bool(abs(current).max() > 0))
+"""
+
+
+def test_the_runtime_is_initialised_on_its_thread_and_kernels_then_run():
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", RUNTIME], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "True", "emaphm-runtime", "True"], out.stdout + out.stderr

@@ -99,3 +99,28 @@ def usable_cores() -> int:
     import os
 
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def runtime_meanwhile() -> threading.Thread:
+    """Start initialising numba's runtime (NRT) on a daemon thread, and return the thread.
+
+    The first kernel a process loads initialises the runtime first (`kernels._jit.QuickLoadCache`):
+    numba compiles the runtime's own functions (its atomic reference counts), 19-25 ms on machine G,
+    most of it inside LLVM, whose calls (through ctypes) release the GIL. A command that will load
+    kernels starts this as soon as numba is imported, so that the compilation runs while the
+    command's own thread imports the rest (issue 36). The initialisation is numba's own: it holds
+    numba's compiler lock (a kernel load that comes first waits for it) and does nothing when
+    called again. An error here is left to that first load, which initialises again and raises it
+    where it belongs. The target context is made on the calling thread first."""
+    from numba.core.registry import cpu_target
+    from numba.core.runtime import rtsys
+
+    context = cpu_target.target_context
+
+    def initialise() -> None:
+        with contextlib.suppress(Exception):
+            rtsys.initialize(context)
+
+    thread = threading.Thread(target=initialise, name="emaphm-runtime", daemon=True)
+    thread.start()
+    return thread

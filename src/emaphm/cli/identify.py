@@ -224,6 +224,9 @@ def _imported_identify() -> Any:
     """`api.identify`, imported; then the collector settled (`emaphm._gc.settled`: the imports'
     objects frozen out of later collections, the thresholds back)."""
     from .._gc import settled
+    from .._threads import runtime_meanwhile
+
+    runtime_meanwhile()  # numba's runtime compiled while the rest imports (`emaphm._threads`)
     from ..identification.api import identify
 
     settled()

@@ -39,6 +39,8 @@ from numba import config, njit
 from numba.core import caching
 from numba.core.runtime import rtsys
 
+from ._linking import LAZY_LINKING, rebuild_lazily
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 KERNEL_DIR = Path(__file__).resolve().parent
@@ -113,14 +115,22 @@ CACHE_ENABLED = _writable(kernel_cache_dir() / __name__.split(".", 1)[0])
 
 
 class QuickLoadCache(caching.FunctionCache):  # type: ignore[misc]
-    """numba's function cache, loading without the target context's refresh and without numba's
-    events on LLVM's lock (module docstring)."""
+    """numba's function cache, loading without the target context's refresh, without numba's
+    events on LLVM's lock and without parsing the bitcode kept for linking (`_linking`; module
+    docstring)."""
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
         with _llvm_lock_events_off():
             rtsys.initialize(target_context)  # what loaded machine code needs of the context
             with self._guard_against_spurious_io_errors():
                 return self._load_overload(sig, target_context)
+
+    def _load_overload(self, sig: Any, target_context: Any) -> Any:
+        """numba's own, the function's library loaded by `_linking.rebuild_lazily`."""
+        if not (LAZY_LINKING and self._enabled):
+            return super()._load_overload(sig, target_context)
+        data = self._cache_file.load(self._index_key(sig, target_context.codegen()))
+        return None if data is None else rebuild_lazily(self._impl, target_context, data)
 
 
 @contextlib.contextmanager
