@@ -26,7 +26,9 @@ else:  # a name the bitcode defines, asked of the engine
 def run(how: str, cache: str) -> list[str]:
     env = {**os.environ, "NUMBA_CACHE_DIR": cache}
     code = "import sys\n" + LOADED
-    out = subprocess.run([sys.executable, "-c", code, how], capture_output=True, text=True, env=env, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code, how], capture_output=True, text=True, env=env, check=True
+    )
     return out.stdout.split()
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
 from typing import TYPE_CHECKING, Any
@@ -73,27 +74,62 @@ def stdout_console() -> Console:
     return Console(highlight=False, width=None if sys.stdout.isatty() else 120)
 
 
+# how long a command runs before its progress bar shows (`progress`)
+PROGRESS_DELAY_S = 1.0
+
+
 @contextmanager
-def progress() -> Iterator[Progress]:
-    """A progress bar on an interactive terminal (one task per stage); a no-op otherwise."""
-    if not err.is_terminal:
-        yield lambda stage, done, total: None
-        return
-    from rich.progress import Progress
+def progress(delay: float = PROGRESS_DELAY_S) -> Iterator[Progress]:
+    """A progress bar on an interactive terminal (one task per stage), shown once the block has
+    run `delay` seconds; a no-op otherwise.
 
-    from ..identification.cmaes import import_cmaes
+    A diagnosis takes about a second (issue 36), and a bar made at its start cost it 4 % on an
+    interactive terminal (rich's console and bar imported, pymoo's CMA-ES imported ahead, the bar's
+    refresh thread; 1.05 against 1.01 s on machine G, BENCHMARKS.md): work that ends within
+    `delay` now shows no bar, imports nothing for one and asks nothing of the terminal. Longer
+    work (a start table's build, a calibration) gets its bar at the first update after `delay`,
+    from the stage then running."""
+    bar = _LateBar(delay)
+    try:
+        yield bar.update
+    finally:
+        bar.stop()
 
-    import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
 
-    with Progress(console=err.console, transient=True) as bar:
-        tasks: dict[str, Any] = {}
+class _LateBar:
+    """`progress`'s bar, made at the first update `delay` seconds after the block began."""
 
-        def update(stage: str, done: int, total: int) -> None:
-            if stage not in tasks:
-                tasks[stage] = bar.add_task(stage, total=total)
-            bar.update(tasks[stage], completed=done)
+    def __init__(self, delay: float) -> None:
+        self._due = time.monotonic() + delay
+        self._bar: Any = None  # rich's Progress once shown; False on no terminal
+        self._tasks: dict[str, Any] = {}
 
-        yield update
+    def update(self, stage: str, done: int, total: int) -> None:
+        if self._bar is None:
+            if time.monotonic() < self._due:
+                return
+            self._bar = self._shown()
+        if self._bar is False:
+            return
+        if stage not in self._tasks:
+            self._tasks[stage] = self._bar.add_task(stage, total=total, completed=done)
+        self._bar.update(self._tasks[stage], completed=done)
+
+    def _shown(self) -> Any:
+        if not err.is_terminal:
+            return False
+        from rich.progress import Progress
+
+        from ..identification.cmaes import import_cmaes
+
+        import_cmaes()  # trims cma's imports only while one thread runs: before the bar's own thread
+        bar = Progress(console=err.console, transient=True)
+        bar.start()
+        return bar
+
+    def stop(self) -> None:
+        if self._bar:
+            self._bar.stop()
 
 
 def bracketed(update: Progress) -> Progress:
