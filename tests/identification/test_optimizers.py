@@ -196,7 +196,9 @@ def test_the_ga_runs_the_offspring_asked_for_and_still_reaches_the_bowl():
         sizes.append(len(X))
         return bowl(X)
 
-    run = run_optimizer("ga", counted, pop_size=20, generations=50, seed=1, stagnation=NO_EARLY_STOP, offspring=10)
+    run = run_optimizer(
+        "ga", counted, pop_size=20, generations=50, seed=1, stagnation=NO_EARLY_STOP, offspring=10
+    )
     assert sizes[0] == 20 and set(sizes[1:]) == {10} and len(sizes) == 50
     assert run.evaluations == 20 + 49 * 10
     assert run.f < 1e-2 and np.linalg.norm(run.x - CENTRE) < 0.1
@@ -295,18 +297,44 @@ def test_the_least_squares_polish_survives_residuals_that_are_not_finite():
 
 def test_import_cmaes_puts_the_blocked_modules_back_when_the_import_fails(monkeypatch):
     import sys
-    import threading
 
+    from emaphm.identification import cmaes
     from emaphm.identification.cmaes import CMA_UNUSED_IMPORTS, import_cmaes
 
     for name in ("cma", *CMA_UNUSED_IMPORTS):
         monkeypatch.delitem(sys.modules, name, raising=False)
     monkeypatch.setitem(sys.modules, "pymoo.algorithms.soo.nonconvex.cmaes", None)  # the import fails
-    monkeypatch.setattr(threading, "active_count", lambda: 1)
+    monkeypatch.setattr(cmaes, "_others_run", lambda: False)  # the blocking in effect
     with pytest.raises(ImportError):
         import_cmaes()
     for name in CMA_UNUSED_IMPORTS:
         assert name not in sys.modules  # not left behind as None: importable again
+
+
+def test_the_polishs_cma_es_imports_lean_beside_emaphms_helper_threads_only():
+    # the twin's thread while the warm-up imports it (`warm.load_search_kernels`): still lean; any
+    # other thread might import the blocked modules meanwhile, so then nothing is blocked
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, threading, time\n"
+        "from emaphm.identification import cmaes\n"
+        "stop = threading.Event()\n"
+        "helper = threading.Thread(target=stop.wait, name='emaphm-measure_0')\n"
+        "helper.start()\n"
+        "print(cmaes._others_run())\n"
+        "cmaes.import_polish()\n"
+        "print('matplotlib' in sys.modules, 'scipy.stats' in sys.modules, 'cma' in sys.modules)\n"
+        "other = threading.Thread(target=stop.wait)\n"
+        "other.start()\n"
+        "print(cmaes._others_run())\n"
+        "stop.set()\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.split()
+    assert out == ["False", "False", "False", "True", "True"], out
 
 
 def test_import_cmaes_leaves_moocore_unimported_and_pymoos_indicators_working():
@@ -324,7 +352,9 @@ def test_import_cmaes_leaves_moocore_unimported_and_pymoos_indicators_working():
         "import moocore\n"
         "print(type(moocore).__name__, moocore.hypervolume(np.array([[0.5, 0.5]]), ref=np.ones(2)))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.split()
     assert out == ["False", "0.31", "module", "0.25"], out
 
 
@@ -345,10 +375,16 @@ def test_the_relative_stop_stops_where_pymoos_objective_space_termination_with_i
         best = 1.0 - np.cumsum(steps) * (0.5 if trial % 2 else 1.0)
         if trial % 5 == 0:
             best[:3] = np.inf  # nothing feasible yet
-        ours, theirs = (RobustTermination(cls(1e-3), period=4) for cls in (RelativeObjectiveTermination, Theirs))
+        ours, theirs = (
+            RobustTermination(cls(1e-3), period=4) for cls in (RelativeObjectiveTermination, Theirs)
+        )
         for g, f in enumerate(best):
             feasible = np.isfinite([f, f + 1.0])
-            algorithm = SimpleNamespace(opt=SimpleNamespace(get=lambda key, f=f, feas=feasible: np.array([f, f + 1.0]) if key == "f" else feas))
+            algorithm = SimpleNamespace(
+                opt=SimpleNamespace(
+                    get=lambda key, f=f, feas=feasible: np.array([f, f + 1.0]) if key == "f" else feas
+                )
+            )
             assert ours.update(algorithm) == theirs.update(algorithm), (trial, g)
             assert ours.has_terminated() == theirs.has_terminated()
 

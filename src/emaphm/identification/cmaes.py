@@ -28,12 +28,29 @@ from numpy.typing import NDArray
 from .ga import Termination
 from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
 
-__all__ = ["CMA_UNUSED_IMPORTS", "cma_seed", "cmaes", "cmaes_minimize", "import_cmaes"]
+__all__ = [
+    "CMA_UNUSED_IMPORTS",
+    "HELPER_THREADS",
+    "cma_seed",
+    "cmaes",
+    "cmaes_minimize",
+    "import_cmaes",
+    "import_polish",
+]
 
 # what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)
 CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
+# the name prefix of emaphm's own helper threads (`_threads.runtime_meanwhile`, `warm.meanwhile`),
+# which import none of `CMA_UNUSED_IMPORTS` nor `moocore`: they do not keep `cma`'s import from being lean
+HELPER_THREADS = "emaphm-"
 # pymoo's CMAES options besides the population, the generations, the bounds and the seed
-PYMOO_CMA_OPTIONS: dict[str, Any] = {"verbose": -9, "verb_log": 0, "maxfevals": np.inf, "tolfun": 1e-11, "tolx": 1e-11}
+PYMOO_CMA_OPTIONS: dict[str, Any] = {
+    "verbose": -9,
+    "verb_log": 0,
+    "maxfevals": np.inf,
+    "tolfun": 1e-11,
+    "tolx": 1e-11,
+}
 
 
 def import_cmaes() -> Any:
@@ -50,16 +67,18 @@ def import_cmaes() -> Any:
     ``platformdirs`` (14 ms on machine G, issue 36, `studies/step_timings.py`) for multi-objective indicators: while pymoo is
     imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions import the real one when
     first called, so pymoo's indicators still work. Only when no other Python thread runs
-    (another thread could import them meanwhile): the CLI calls this before its progress bar
-    starts a thread.
+    but emaphm's own helpers (`HELPER_THREADS`; another thread could import them meanwhile): the
+    CLI calls this before its progress bar starts a thread.
     """
     with _lean_imports(moocore=True):
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
     return CMAES
 
 
-def _my_fmin() -> Any:
-    """pymoo's generator around `cma` (``pymoo.vendor.vendor_cmaes.my_fmin``), imported lean."""
+def import_polish() -> Any:
+    """pymoo's generator around `cma` (``pymoo.vendor.vendor_cmaes.my_fmin``), which the polishes
+    run (`cmaes_minimize`), imported lean as `import_cmaes` imports (14 ms on machine G the first
+    time; `warm.load_search_kernels` imports it while the twin measures)."""
     with _lean_imports(moocore=False):
         from pymoo.vendor.vendor_cmaes import my_fmin
     return my_fmin
@@ -69,7 +88,7 @@ def _my_fmin() -> Any:
 def _lean_imports(*, moocore: bool) -> Iterator[None]:
     """`CMA_UNUSED_IMPORTS` blocked and (with `moocore`) `moocore` stood in for while `cma` is
     first imported (`import_cmaes`); nothing once it is, or while another thread runs."""
-    if "cma" in sys.modules or threading.active_count() > 1:
+    if "cma" in sys.modules or _others_run():
         yield
         return
     blocked = [name for name in CMA_UNUSED_IMPORTS if name not in sys.modules]
@@ -88,6 +107,12 @@ def _lean_imports(*, moocore: bool) -> Iterator[None]:
                 del sys.modules[name]
         if stand_in is not None and sys.modules.get("moocore") is stand_in:
             del sys.modules["moocore"]
+
+
+def _others_run() -> bool:
+    """Whether a Python thread runs beside this one that is not one of emaphm's helpers."""
+    me = threading.current_thread()
+    return any(t is not me and not t.name.startswith(HELPER_THREADS) for t in threading.enumerate())
 
 
 class _LazyMoocore(types.ModuleType):
@@ -144,7 +169,7 @@ def cmaes_minimize(
     termination, log = Termination(generations, stagnation), GenerationLog(generations, on_generation)
     options = {**PYMOO_CMA_OPTIONS, "popsize": pop_size, "maxiter": generations,
                "bounds": [np.zeros_like(xl), np.ones_like(xu)], "seed": seed}  # fmt: skip
-    es = _my_fmin()(
+    es = import_polish()(
         (x_best[0] - xl) / span, sigma, options=options, parallel_objective=True, restarts=0,
         restart_from_best="False", incpopsize=2, eval_initial_x=False, noise_handler=None,
         noise_change_sigma_exponent=1, noise_kappa_exponent=0, bipop=False,

@@ -9,7 +9,8 @@ of the Table 1 case, `benchmarks/bench_hf.py`) holds neither the interpreter nor
 measures, its kernels are loaded first by a run over `TWIN_SPAN_S`, the whole run goes on a
 thread, and meanwhile `load_search_kernels` loads the search's by calls on a short synthetic
 recording through the same Python paths the search takes: the same signatures, so the search
-loads nothing more (tests/identification/test_warm.py). The measurement and the search are
+loads nothing more (tests/identification/test_warm.py); and it imports the polishes' CMA-ES, as
+lean as the polish would (the twin's thread is one of emaphm's helpers, `cmaes.HELPER_THREADS`). The measurement and the search are
 unchanged: only when the loads happen moves (0.959x the Table 1 case's time from the shell,
 BENCHMARKS.md, issue 36, sixteenth session).
 """
@@ -39,7 +40,10 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     """Call, on a synthetic recording of `LOAD_SPAN_S` (a ramp of current), every kernel the search
     calls through its own Python path: the fused fitness and residual kernels (`Fitness`), the
     monitor's runs alone and as a population, and the comparison filter on one and on several
-    signals. Their numbers are thrown away."""
+    signals. Their numbers are thrown away. Then import the polishes' CMA-ES (`cmaes.import_polish`),
+    which the search's second stage would import: Python under the GIL, which the twin's compiled
+    run beside it does not need."""
+    from .cmaes import import_polish
     from .fitness import Fitness
     from .signals import Comparison
 
@@ -54,6 +58,7 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     monitor.simulate(HEALTHY, duration=LOAD_SPAN_S)
     monitor.simulate_many(K, duration=LOAD_SPAN_S, check=False)
     comparison.filtered(np.zeros((2, len(t))))
+    import_polish()  # the polishes' CMA-ES, which the search would import in its second stage
 
 
 def meanwhile(work: Callable[[], T], other: Callable[[], None]) -> T:
