@@ -86,6 +86,28 @@ from emaphm.cli import main
 main()
 """
 
+LOADS_LAZY = """
+import sys, time
+import emaphm.identification.api
+from emaphm.kernels import _jit
+if sys.argv[1] == "off":
+    _jit.LAZY_LINKING = False  # numba's own loading (a tree before the seventeenth session has no switch)
+from numba.core.registry import cpu_target
+from numba.core.runtime import rtsys
+from emaphm.commands import Chirp
+from emaphm.identification import cmaes, warm
+from emaphm.models import HighFidelityEma, MonitorEma
+cmaes.import_polish()
+monitor, twin = MonitorEma(), HighFidelityEma(command=Chirp())
+t0 = time.perf_counter()
+rtsys.initialize(cpu_target.target_context)
+t1 = time.perf_counter()
+twin.simulate([0.2383, 0.5003, 0.0, 0.4503, 0.0404, 0.0028, 0.2785, 0.5], seed=5, duration=0.002)
+t2 = time.perf_counter()
+warm.load_search_kernels(monitor)
+print(t1 - t0, t2 - t1, time.perf_counter() - t2)
+"""
+
 MOOCORE = """
 import time
 import emaphm.identification.api
@@ -187,6 +209,11 @@ def main(argv: list[str] | None = None) -> None:
     for name, way in runs.items():
         print(f"6. the monitor, {name}: {spread(per_call(way, args.repeats, 50))} ms")
     switching_runs(args.repeats)
+    if hasattr(_jit, "LAZY_LINKING"):
+        for mode in ("on", "off"):
+            runs = np.array([[float(v) for v in fresh(LOADS_LAZY, mode)] for _ in range(args.repeats)])
+            print(f"9. fresh process, lazy linking {mode}: the runtime {spread(list(runs[:, 0]))} ms, the twin's "
+                  f"kernels {spread(list(runs[:, 1]))} ms, the search's {spread(list(runs[:, 2]))} ms")
     for mode in ("on", "off"):
         runs = [fresh(COLLECTOR, mode)[-4:] for _ in range(args.repeats)]
         counts = "/".join(str(int(np.median([int(r[g]) for r in runs]))) for g in (1, 2, 3))

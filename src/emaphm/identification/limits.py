@@ -200,12 +200,12 @@ POSITION_SCALE_TOLERANCE = 0.05
 # 0.994 on the hysteresis drive; one case of bench_foc.py (seed 3203, case 1: shorts 0.47 and
 # 0.07) 3.4 %. A scaled current that explains a recording CURRENT_SCALE_RATIO x better (Σ w·e²),
 # γ off 1 by CURRENT_SCALE_RATIO_GAIN, is also doubtful: the same 126 runs reach 1.34 (1.16 and
-# 1.34 at γ 0.98), a gain 1.05 with three shorts present 1.17-2.2 at γ 1.020-1.029. And the
-# monitor runs each of the two Levenberg-Marquardt refits (scaled, unscaled) may take
+# 1.34 at γ 0.98), a gain 1.05 with three shorts present 1.17-2.2 at γ 1.020-1.029. Each refit's
+# trial points: 20 (40 before) changed no doubt in 235 refits run both ways (BENCHMARKS.md, issue 36)
 CURRENT_SCALE_SPREAD = 0.026
 CURRENT_SCALE_RATIO = 1.4
 CURRENT_SCALE_RATIO_GAIN = 0.01
-CURRENT_SCALE_NFEV = 40
+CURRENT_SCALE_NFEV = 20
 
 # ---- the last stage (`last_stage`) ----
 # the switching model's integration steps as multiples of the actuator's own step dt: the twin's
