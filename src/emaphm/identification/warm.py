@@ -43,7 +43,20 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     signals. Their numbers are thrown away. Then import the polishes' CMA-ES (`cmaes.import_polish`),
     which the search's second stage would import: Python under the GIL, which the twin's compiled
     run beside it does not need."""
+    import numba
+
     from .cmaes import import_polish
+
+    threads = numba.get_num_threads()  # this thread's: the parallel kernels run on one here
+    numba.set_num_threads(1)
+    try:
+        _load(monitor)
+    finally:
+        numba.set_num_threads(threads)
+    import_polish()  # the polishes' CMA-ES, which the search would import in its second stage
+
+
+def _load(monitor: MonitorEma) -> None:
     from .fitness import Fitness
     from .signals import Comparison
 
@@ -58,7 +71,6 @@ def load_search_kernels(monitor: MonitorEma) -> None:
     monitor.simulate(HEALTHY, duration=LOAD_SPAN_S)
     monitor.simulate_many(K, duration=LOAD_SPAN_S, check=False)
     comparison.filtered(np.zeros((2, len(t))))
-    import_polish()  # the polishes' CMA-ES, which the search would import in its second stage
 
 
 def meanwhile(work: Callable[[], T], other: Callable[[], None]) -> T:
