@@ -28,3 +28,14 @@ def test_a_simulation_record_is_not_a_window_into_the_packaged_calibration():
     result = MonitorEma().simulate(duration=0.01)
     result.metadata["calibration"]["settings"]["params"]["motor"]["R_s"] = 99.0
     assert default_calibration().params["motor"]["R_s"] == EmaParams().motor.R_s
+
+
+def test_the_interval_calibration_handed_out_is_a_copy_too():
+    from emaphm.identification.uncertainty import load_factors
+
+    first = load_factors()
+    pristine = copy.deepcopy(first.record)
+    nested = next(v for v in first.record.values() if isinstance(v, dict) and v)
+    nested.clear()
+    first.record["created"] = "never"
+    assert load_factors().record == pristine and pristine["created"] != "never"

@@ -14,7 +14,6 @@ noise levels (``sensors.sigma_*``) are not part of the actuator nor of the diges
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import functools
 import hashlib
@@ -25,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .._data import read_package_json
+from .._data import read_package_json, record_copy
 from ..errors import InputError
 from ..params import EmaParams
 from .coefficients import COEFFICIENT_BOUNDS, SURROGATE, Coefficients
@@ -252,7 +251,7 @@ def default_calibration(monitor: str = "default") -> Calibration:
     changes it cannot change what the next one gets (the coefficients are frozen).
     """
     cal = _packaged(check_monitor(monitor))
-    return dataclasses.replace(cal, record=copy.deepcopy(cal.record))
+    return dataclasses.replace(cal, record=record_copy(cal.record))
 
 
 @functools.lru_cache(maxsize=len(MONITOR_FILES))

@@ -7,7 +7,6 @@ cases that no benchmark uses (`fit_factors`, ``emaphm calibrate-uq``) and shippe
 
 from __future__ import annotations
 
-import copy
 import functools
 import json
 import os
@@ -18,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..._data import read_package_json
+from ..._data import read_package_json, record_copy
 from ...errors import InputError
 from ...faults import FAULT_NAMES
 from .intervals import N_PARAMS, PHASE, ZETA, covers, half_widths, intervals
@@ -160,7 +159,7 @@ def load_factors(path: str | os.PathLike[str] | None = None, *, last_stage: str 
         if last_stage not in PACKAGED_FACTORS:
             raise InputError(f"no packaged interval calibration for the last stage {last_stage!r}")
         shared = _packaged(last_stage)  # its arrays read-only; the record each caller's own copy
-        return Factors(shared.scale, shared.floor, copy.deepcopy(shared.record))
+        return Factors(shared.scale, shared.floor, record_copy(shared.record))
     p = Path(path)
     try:
         data = json.loads(p.read_text())
