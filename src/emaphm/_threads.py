@@ -105,7 +105,7 @@ def runtime_meanwhile() -> threading.Thread:
     """Start initialising numba's runtime (NRT) on a daemon thread, and return the thread.
 
     The first kernel a process loads initialises the runtime first (`kernels._jit.QuickLoadCache`):
-    numba compiles the runtime's own functions (its atomic reference counts), 19-25 ms on machine G,
+    numba compiles the runtime's own functions (its atomic reference counts), 17-25 ms on machine G,
     most of it inside LLVM, whose calls (through ctypes) release the GIL. A command that will load
     kernels starts this as soon as numba is imported, so that the compilation runs while the
     command's own thread imports the rest (issue 36). The initialisation is numba's own: it holds

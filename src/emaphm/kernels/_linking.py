@@ -6,8 +6,8 @@ for two uses only: the names the module defines, entered in the execution engine
 (``JitEngine.is_symbol_defined``), and the module a later compilation links in when the function
 it compiles calls this one (``_get_module_for_linking``). A diagnosis calls its kernels from
 Python and compiles nothing after them, and the fused kernels' modules are large (the monitor and
-the filter inlined): the parses were 17 of the 30 ms that loading the search's kernels took on
-machine G (`studies/step_timings.py` item 9).
+the filter inlined): loading the search's kernels took 32 ms on machine G with the parses, 10 ms
+without, the twin's 24 and 19 ms (`studies/step_timings.py` item 9).
 
 `rebuild_lazily` loads a cached function's machine code as numba does and keeps its bitcode
 unparsed. The library's class becomes a subclass whose ``_get_module_for_linking`` parses the
