@@ -311,12 +311,19 @@ def test_import_cmaes_puts_the_blocked_modules_back_when_the_import_fails(monkey
         assert name not in sys.modules  # not left behind as None: importable again
 
 
-def test_the_polishs_cma_es_imports_lean_beside_emaphms_helper_threads_only():
-    # the twin's thread while the warm-up imports it (`warm.load_search_kernels`): still lean; any
-    # other thread might import the blocked modules meanwhile, so then nothing is blocked
+def in_a_fresh_process(code: str) -> list[str]:
+    """What `code` prints in a new interpreter, split on whitespace."""
     import subprocess
     import sys
 
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.split()
+
+
+def test_the_polishs_cma_es_imports_lean_beside_emaphms_helper_threads_only():
+    # the twin's thread while the warm-up imports it (`warm.load_search_kernels`): still lean; any
+    # other thread might import the blocked modules meanwhile, so then nothing is blocked
     code = (
         "import sys, threading, time\n"
         "from emaphm.identification import cmaes\n"
@@ -331,17 +338,12 @@ def test_the_polishs_cma_es_imports_lean_beside_emaphms_helper_threads_only():
         "print(cmaes._others_run())\n"
         "stop.set()\n"
     )
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True
-    ).stdout.split()
+    out = in_a_fresh_process(code)
     assert out == ["False", "False", "False", "True", "True"], out
 
 
 def test_import_cmaes_leaves_moocore_unimported_and_pymoos_indicators_working():
     # the stand-in `cmaes._LazyMoocore`: pymoo's hypervolume imports the real moocore when called
-    import subprocess
-    import sys
-
     code = (
         "import sys, numpy as np\n"
         "from emaphm.identification.cmaes import import_cmaes\n"
@@ -352,9 +354,7 @@ def test_import_cmaes_leaves_moocore_unimported_and_pymoos_indicators_working():
         "import moocore\n"
         "print(type(moocore).__name__, moocore.hypervolume(np.array([[0.5, 0.5]]), ref=np.ones(2)))\n"
     )
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True
-    ).stdout.split()
+    out = in_a_fresh_process(code)
     assert out == ["False", "0.31", "module", "0.25"], out
 
 
