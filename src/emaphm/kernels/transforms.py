@@ -59,12 +59,10 @@ def phase_directions(sin_e, cos_e):  # type: ignore[no-untyped-def]
 
 @jit
 def q_error(e_a, e_b, e_c, theta_e, i_q, out):  # type: ignore[no-untyped-def]
-    """out = i_q + the q component of the phase-current errors (e_a, e_b, e_c) at θ_e, sample by
-    sample: `clarke`, then `park`'s i_q, the numbers the two give on arrays (the same operations
-    in the same order), in a loop that allocates nothing (the twin's measured i_q,
-    `models.hf`: array code made its load import numba's array and ufunc modules, about 25 ms of
-    a diagnosis's start, issue 36)."""
+    """out = i_q + the q component of the phase-current errors (e_a, e_b, e_c) at θ_e: `clarke`,
+    then `park`'s i_q, sample by sample in a loop that allocates nothing (the twin's measured i_q,
+    `models.hf`: the two on arrays made its load import numba's array and ufunc modules, about
+    25 ms of a diagnosis's start, issue 36); the numbers they give on arrays."""
     for k in range(i_q.shape[0]):
-        i_alpha = (2.0 / 3.0) * (e_a[k] - 0.5 * e_b[k] - 0.5 * e_c[k])
-        i_beta = (e_b[k] - e_c[k]) / SQRT3
-        out[k] = i_q[k] + (-i_alpha * math.sin(theta_e[k]) + i_beta * math.cos(theta_e[k]))
+        i_alpha, i_beta = clarke(e_a[k], e_b[k], e_c[k])
+        out[k] = i_q[k] + park(i_alpha, i_beta, theta_e[k])[1]
