@@ -28,6 +28,10 @@ from .errors import InputError
 T = TypeVar("T")
 R = TypeVar("R")
 
+# the name prefix of emaphm's own helper threads (`runtime_meanwhile`'s, `warm.meanwhile`'s), which
+# import nothing `cmaes`'s lean import blocks: they do not keep that import from being lean
+HELPER_THREADS = "emaphm-"
+
 _OPEN = threading.local()  # .blocks: this thread's open numba_threads blocks, innermost last
 
 
@@ -121,6 +125,6 @@ def runtime_meanwhile() -> threading.Thread:
         with contextlib.suppress(Exception):
             rtsys.initialize(context)
 
-    thread = threading.Thread(target=initialise, name="emaphm-runtime", daemon=True)
+    thread = threading.Thread(target=initialise, name=f"{HELPER_THREADS}runtime", daemon=True)
     thread.start()
     return thread

@@ -25,12 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._threads import HELPER_THREADS
 from .ga import Termination
 from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
 
 __all__ = [
     "CMA_UNUSED_IMPORTS",
-    "HELPER_THREADS",
     "cma_seed",
     "cmaes",
     "cmaes_minimize",
@@ -40,9 +40,6 @@ __all__ = [
 
 # what `cma` imports at its own import for plots and surrogate models (`import_cmaes`)
 CMA_UNUSED_IMPORTS = ("matplotlib", "matplotlib.pyplot", "scipy.stats")
-# the name prefix of emaphm's own helper threads (`_threads.runtime_meanwhile`, `warm.meanwhile`),
-# which import none of `CMA_UNUSED_IMPORTS` nor `moocore`: they do not keep `cma`'s import from being lean
-HELPER_THREADS = "emaphm-"
 # pymoo's CMAES options besides the population, the generations, the bounds and the seed
 PYMOO_CMA_OPTIONS: dict[str, Any] = {
     "verbose": -9,
@@ -66,9 +63,9 @@ def import_cmaes() -> Any:
     termination), which imports `moocore` with its data sets, ``urllib.request`` and
     ``platformdirs`` (14 ms on machine G, issue 36, `studies/step_timings.py`) for multi-objective indicators: while pymoo is
     imported, `moocore` is a stand-in (`_LazyMoocore`) whose functions import the real one when
-    first called, so pymoo's indicators still work. Only when no other Python thread runs
-    but emaphm's own helpers (`HELPER_THREADS`; another thread could import them meanwhile): the
-    CLI calls this before its progress bar starts a thread.
+    first called, so pymoo's indicators still work. Only when no other Python thread runs but
+    emaphm's own helpers (`_threads.HELPER_THREADS`; another thread could import them meanwhile):
+    the CLI calls this before its progress bar starts a thread.
     """
     with _lean_imports(moocore=True):
         from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
@@ -87,7 +84,8 @@ def import_polish() -> Any:
 @contextlib.contextmanager
 def _lean_imports(*, moocore: bool) -> Iterator[None]:
     """`CMA_UNUSED_IMPORTS` blocked and (with `moocore`) `moocore` stood in for while `cma` is
-    first imported (`import_cmaes`); nothing once it is, or while another thread runs."""
+    first imported (`import_cmaes`); nothing once it is, or while a thread other than emaphm's
+    helpers runs (`_others_run`)."""
     if "cma" in sys.modules or _others_run():
         yield
         return

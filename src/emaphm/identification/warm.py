@@ -2,17 +2,20 @@
 
 A fresh process loads each compiled kernel from numba's cache when it is first called: the
 twin's with numba's own start, then, inside the search, the monitor's, the comparison filter's
-and the fused fitness kernels' (together 56 ms on machine G, `studies/step_timings.py` item 1).
-The twin's run that makes the measurement (`recording.measurement`; 0.05 s per simulated second
-of the Table 1 case, `benchmarks/bench_hf.py`) holds neither the interpreter nor numba's compiler
-(its kernel is ``nogil``) and keeps one core busy while the other waited. So when the twin
-measures, its kernels are loaded first by a run over `TWIN_SPAN_S`, the whole run goes on a
-thread, and meanwhile `load_search_kernels` loads the search's by calls on a short synthetic
-recording through the same Python paths the search takes: the same signatures, so the search
-loads nothing more (tests/identification/test_warm.py); and it imports the polishes' CMA-ES, as
-lean as the polish would (the twin's thread is one of emaphm's helpers, `cmaes.HELPER_THREADS`). The measurement and the search are
-unchanged: only when the loads happen moves (0.959x the Table 1 case's time from the shell,
-BENCHMARKS.md, issue 36, sixteenth session).
+and the fused fitness kernels' (10 ms on machine G since they load without their linking bitcode's
+parse, `studies/step_timings.py` item 9). The twin's run that makes the measurement
+(`recording.measurement`; 0.05 s per simulated second of the Table 1 case, `benchmarks/bench_hf.py`)
+holds neither the interpreter nor numba's compiler (its kernel is ``nogil``) and keeps one core
+busy while the other waited. So when the twin measures, its kernels are loaded first by a run over
+`TWIN_SPAN_S`, the whole run goes on a thread, and meanwhile `load_search_kernels` loads the
+search's by calls on a short synthetic recording through the same Python paths the search takes:
+the same signatures, so the search loads nothing more (tests/identification/test_warm.py). Those
+calls run on one numba thread: on two, numba's second worker took the core the twin's run needs
+(the measurement 62 -> 51 ms in-process, BENCHMARKS.md, seventeenth session). Then it imports the
+polishes' CMA-ES, as lean as the polish would (the twin's thread is one of emaphm's helpers,
+`_threads.HELPER_THREADS`). The measurement and the search are unchanged: only when the loads
+happen moves (0.959x the Table 1 case's time from the shell, BENCHMARKS.md, issue 36, sixteenth
+session).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
+from .._threads import HELPER_THREADS
 from ..faults import HEALTHY
 
 if TYPE_CHECKING:
@@ -53,7 +57,7 @@ def load_search_kernels(monitor: MonitorEma) -> None:
         _load(monitor)
     finally:
         numba.set_num_threads(threads)
-    import_polish()  # the polishes' CMA-ES, which the search would import in its second stage
+    import_polish()
 
 
 def _load(monitor: MonitorEma) -> None:
@@ -76,7 +80,7 @@ def _load(monitor: MonitorEma) -> None:
 def meanwhile(work: Callable[[], T], other: Callable[[], None]) -> T:
     """`work()` on a thread while `other()` runs on this one; `work`'s result (or its exception,
     raised here once `other` is done)."""
-    with ThreadPoolExecutor(1, thread_name_prefix="emaphm-measure") as pool:
+    with ThreadPoolExecutor(1, thread_name_prefix=f"{HELPER_THREADS}measure") as pool:
         pending = pool.submit(work)
         other()
         return pending.result()
