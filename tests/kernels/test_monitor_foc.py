@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from emaphm.kernels.monitor import IDX, N_FIELDS, foc_loop_step
+from emaphm.kernels.monitor import IDX, N_FIELDS, foc_loop_step, foc_pack
 
 L, R, H = 1.5e-3, 0.5, 50e-6
 
@@ -31,7 +31,7 @@ def loop_steps(prm, n, i_ref=1.0):
     i = I = v1 = v2 = 0.0
     out = np.empty(n)
     for j in range(n):
-        i, I, v1, v2, _ = foc_loop_step(i, I, v1, v2, i_ref, 0.0, 1.0, 1.0, H, prm)
+        i, I, v1, v2, _ = foc_loop_step(i, I, v1, v2, i_ref, 0.0, 1.0, 1.0, H, foc_pack(prm))
         out[j] = i
     return out
 
@@ -76,7 +76,7 @@ def test_pole_zero_cancellation_gives_the_first_order_bandwidth():
 def test_the_voltage_limit_holds_the_integrator():
     prm = row(9.42, 3141.6, 1, V_lim=1.0)
     i = I = v1 = v2 = 0.0
-    i, I, v1, v2, _ = foc_loop_step(i, I, v1, v2, 5.0, 0.0, 1.0, 1.0, H, prm)
+    i, I, v1, v2, _ = foc_loop_step(i, I, v1, v2, 5.0, 0.0, 1.0, 1.0, H, foc_pack(prm))
     assert v1 == 1.0 and I == 0.0  # limited: the demanded 47 V held at 1 V, nothing integrated
 
 

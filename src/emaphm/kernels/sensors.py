@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
-import math
+import numpy as np
 
 from ._jit import jit
 
 
 @jit
 def quantise(x: float, lsb: float, full_scale: float) -> float:
-    """Mid-tread quantiser with step `lsb`, saturating at ±full_scale; lsb = 0 is an ideal ADC."""
+    """Mid-tread quantiser with step `lsb`, saturating at ±full_scale; lsb = 0 is an ideal ADC.
+
+    numpy's floor, a float, not math's: math.floor returns an integer, and the conversions to it
+    and back sat in the monitor's step chain (the same numbers: every code is below 2⁵³)."""
     if lsb > 0.0:
-        x = lsb * math.floor(x / lsb + 0.5)
+        x = lsb * np.floor(x / lsb + 0.5)
         hi = full_scale - lsb  # a two's-complement ADC: one code fewer on the positive side
     else:
         hi = full_scale
