@@ -16,7 +16,6 @@ from __future__ import annotations
 import contextlib
 import importlib
 import sys
-import threading
 import types
 import warnings
 from collections.abc import Iterator
@@ -25,7 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._threads import HELPER_THREADS
+from .._threads import others_run as _others_run
 from .ga import Termination
 from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
 
@@ -105,12 +104,6 @@ def _lean_imports(*, moocore: bool) -> Iterator[None]:
                 del sys.modules[name]
         if stand_in is not None and sys.modules.get("moocore") is stand_in:
             del sys.modules["moocore"]
-
-
-def _others_run() -> bool:
-    """Whether a Python thread runs beside this one that is not one of emaphm's helpers."""
-    me = threading.current_thread()
-    return any(t is not me and not t.name.startswith(HELPER_THREADS) for t in threading.enumerate())
 
 
 class _LazyMoocore(types.ModuleType):
