@@ -15,6 +15,8 @@ from emaphm.kernels.monitor import (
     phi_ecc,
     phi_sc,
     phi_t,
+    shape_harmonics,
+    shapes,
     simulate_lf,
     simulate_lf2,
     simulate_lf_many,
@@ -229,3 +231,25 @@ def test_the_loop_surrogate_carries_no_current_at_rest_and_opposes_the_voltage()
     assert -0.2 < loop_error(-0.2, 0.0, 0.0, 0.005, **args) < 0.0
     assert loop_error(0.0, 5.0, 0.0, 0.005, **args) == pytest.approx(-0.005)
     assert loop_error(0.0, -5.0, 0.0, 0.005, **args) == pytest.approx(0.005)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_steps_trig_polynomials_are_the_shape_functions(seed):
+    """The step evaluates φ_SC, φ_T and c₂ from run constants (`shape_harmonics`, `shapes`): the
+    same functions as eqs. 1-2, `phi_t` and `unbalance_2` at every angle, to rounding, with either
+    coupling."""
+    rng = np.random.default_rng(seed)
+    N = rng.uniform(0.4, 1.0, 3) if seed else np.ones(3)
+    k_FT, k_FS, kz, phi_e = rng.uniform(0.005, 2.0), rng.uniform(0.0, 100.0), rng.uniform(0.0, 0.5), rng.uniform(-3.2, 3.2)
+    hz = shape_harmonics(*N, k_FT, k_FS, kz, phi_e)
+    kz_cos, kz_sin = kz * np.cos(phi_e), kz * np.sin(phi_e)
+    for t in THETA[::7]:
+        s, c = np.sin(t), np.cos(t)
+        f_ecc = phi_ecc(s, c, kz_cos, kz_sin)
+        scale = k_FT * (1.0 + k_FS)
+        f_sc, f_t, c2 = shapes(s, c, hz, True, kz_cos, kz_sin)
+        assert f_sc == pytest.approx(phi_sc(s, c, *N, k_FT, k_FS), abs=1e-13 * scale)
+        assert f_t == pytest.approx(phi_t(s, c, *N, k_FT, k_FS, f_ecc, ecc_harmonics(kz, phi_e)), abs=1e-13 * scale)
+        assert c2 == pytest.approx(unbalance_2(s, c, *N), abs=1e-14)
+        _, paper, _ = shapes(s, c, hz, False, kz_cos, kz_sin)
+        assert paper == pytest.approx(phi_sc(s, c, *N, k_FT, k_FS) * f_ecc, abs=1e-13 * scale)
