@@ -253,3 +253,12 @@ def test_the_steps_trig_polynomials_are_the_shape_functions(seed):
         assert c2 == pytest.approx(unbalance_2(s, c, *N), abs=1e-14)
         _, paper, _ = shapes(s, c, hz, False, kz_cos, kz_sin)
         assert paper == pytest.approx(phi_sc(s, c, *N, k_FT, k_FS) * f_ecc, abs=1e-13 * scale)
+
+
+def test_the_saturated_tanh_is_libms_to_the_bit():
+    import math
+
+    x = np.concatenate([np.linspace(-40.0, 40.0, 8001), [21.999999, 22.0, 22.000001, -22.0, 1e300, -1e300, np.inf, -np.inf]])
+    for v in x:
+        assert lf_kernel.saturated_tanh(v) == math.tanh(v)
+    assert np.isnan(lf_kernel.saturated_tanh(np.nan))
