@@ -133,15 +133,18 @@ def main(argv: list[str] | None = None) -> None:
     """Entry point: runs the app and maps errors to exit status and a one-line reason.
 
     Without `argv` this is the process's own entry point (the ``emaphm`` script, ``python -m
-    emaphm``): it raises the collector's threshold while the process imports (`emaphm._gc`;
-    a command settles it once its imports are done) and ends the process itself
+    emaphm``): it byte-compiles emaphm once where Python writes no bytecode (`emaphm._bytecode`),
+    raises the collector's threshold while the process imports (`emaphm._gc`; a command settles
+    it once its imports are done) and ends the process itself
     (`_process_exit`) instead of returning. With `argv` (a test, a study) it returns, or raises
     SystemExit, as any function, the collector as the caller has it."""
     if argv is not None:
         _main(argv)
         return
+    from .._bytecode import compile_package
     from .._gc import quiet_start
 
+    compile_package()  # once, where Python writes no bytecode (`emaphm._bytecode`)
     quiet_start()  # the collector while the process imports (`emaphm._gc`)
     try:
         _main(None)
