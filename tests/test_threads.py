@@ -167,30 +167,3 @@ def test_the_runtime_is_initialised_on_its_thread_and_kernels_then_run():
     out = subprocess.run([sys.executable, "-c", RUNTIME], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "True", "emaphm-runtime", "True"], out.stdout + out.stderr
 
-
-LEAN_NUMBA = """
-import sys
-from emaphm._threads import import_numba
-import_numba()
-import numba
-loaded = [name for name in ("scipy", "yaml") if name in sys.modules]
-import scipy, yaml  # importable afterwards
-print(loaded, numba.config.NUMBA_NUM_THREADS)
-"""
-
-
-def test_numba_imports_without_scipy_and_yaml_which_stay_importable(tmp_path):
-    import subprocess
-    import sys
-
-    out = subprocess.run([sys.executable, "-c", LEAN_NUMBA], capture_output=True, text=True, check=True, cwd=tmp_path)
-    assert out.stdout.split()[0] == "[]", out.stdout + out.stderr
-
-
-def test_numba_still_reads_its_config_file_in_the_working_folder(tmp_path):
-    import subprocess
-    import sys
-
-    (tmp_path / ".numba_config.yaml").write_text("num_threads: 1\n")
-    out = subprocess.run([sys.executable, "-c", LEAN_NUMBA], capture_output=True, text=True, check=True, cwd=tmp_path)
-    assert out.stdout.split() == ["['yaml']", "1"], out.stdout + out.stderr

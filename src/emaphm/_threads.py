@@ -105,40 +105,10 @@ def usable_cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-# what numba's own import loads for nothing here: scipy, only to check its version (numba needs none
-# of it until a kernel using scipy's LAPACK compiles), and yaml, to read a config file
-# (`NUMBA_CONFIG_FILE`) that is not there; 16-19 ms of a diagnosis's start on machine G (issue 36)
-NUMBA_UNUSED_IMPORTS = ("scipy", "yaml")
-NUMBA_CONFIG_FILE = ".numba_config.yaml"  # numba.core.config's _config_fname, read from the working folder
-
-
 def others_run() -> bool:
     """Whether a Python thread runs beside this one that is not one of emaphm's helpers."""
     me = threading.current_thread()
     return any(t is not me and not t.name.startswith(HELPER_THREADS) for t in threading.enumerate())
-
-
-def import_numba() -> None:
-    """Import numba without `NUMBA_UNUSED_IMPORTS`: those not loaded yet are made unimportable
-    (None in ``sys.modules``, which numba's import catches) while numba imports, then put back, so
-    anyone imports them afterwards. yaml stays importable when the working folder has numba's
-    config file (`NUMBA_CONFIG_FILE`), which numba then reads as always. A plain import once numba
-    is imported, or while a thread other than emaphm's helpers runs (it could import them meanwhile)."""
-    import os
-    import sys
-
-    blocked = []
-    if "numba" not in sys.modules and not others_run():
-        unused = [n for n in NUMBA_UNUSED_IMPORTS if not (n == "yaml" and os.path.isfile(NUMBA_CONFIG_FILE))]
-        blocked = [name for name in unused if name not in sys.modules]
-    for name in blocked:
-        sys.modules[name] = None  # type: ignore[assignment]
-    try:
-        import numba  # noqa: F401
-    finally:
-        for name in blocked:
-            if name in sys.modules and sys.modules[name] is None:
-                del sys.modules[name]
 
 
 def runtime_meanwhile() -> threading.Thread:
@@ -151,9 +121,8 @@ def runtime_meanwhile() -> threading.Thread:
     command's own thread imports the rest (issue 36). The initialisation is numba's own: it holds
     numba's compiler lock (a kernel load that comes first waits for it) and does nothing when
     called again. An error here is left to that first load, which initialises again and raises it
-    where it belongs. The target context is made on the calling thread first, numba imported lean
-    (`import_numba`) if it is not yet."""
-    import_numba()
+    where it belongs. The target context is made on the calling thread first (a command imports
+    numba lean before, `_lean_numba.import_numba`)."""
     from numba.core.registry import cpu_target
     from numba.core.runtime import rtsys
 

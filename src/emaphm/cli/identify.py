@@ -224,8 +224,10 @@ def _imported_identify() -> Any:
     """`api.identify`, imported; then the collector settled (`emaphm._gc.settled`: the imports'
     objects frozen out of later collections, the thresholds back)."""
     from .._gc import settled
+    from .._lean_numba import import_numba
     from .._threads import runtime_meanwhile
 
+    import_numba()  # without what its import loads for nothing here (`emaphm._lean_numba`)
     runtime_meanwhile()  # numba's runtime compiled while the rest imports (`emaphm._threads`)
     from ..identification.api import identify
 
