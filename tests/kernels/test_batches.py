@@ -61,3 +61,7 @@ def test_the_kernels_give_the_same_numbers_whatever_the_plan(n_threads):
             one = np.empty(1)
             fitness_lf_many(theta_cmd, rows[r : r + 1], f.sos, f.zi, f.padlen, f.comparison.reference, f.weights, one, 1)
             assert one[0] == fit_ref[r]
+            alone = np.empty((1, len(keep)))
+            residuals_lf_many(theta_cmd, rows[r : r + 1], f.sos, f.zi, f.padlen, keep, f.comparison.reference[keep],
+                              np.sqrt(f.weights[keep]), alone, 1)  # fmt: skip
+            np.testing.assert_array_equal(alone[0], res_ref[r])

@@ -19,7 +19,9 @@ not depend on the number of threads. A row whose LF current is not finite gets N
 
 The filter is a chain of dependent multiply-adds (≈ 6.5 ns per sample and pass, against ≈ 43 ns
 per sample for the LF run itself): each thread filters two rows at once, interleaved, so that the
-two chains overlap (measured 131 µs per row alone, 79 µs per row in pairs, 10001 samples).
+two chains overlap (measured 131 µs per row alone, 79 µs per row in pairs, 10001 samples), and
+four, two of its pairs, where it has them (machine G: 4 rows 132 µs as two pairs, 73 µs at once;
+issue 36, eighteenth session).
 
 The filter (`sos`, `zi`, `pad`) is designed in Python (`signals.comparison_filter`) once per
 identification and passed in. `sosfiltfilt_many` and `sosfiltfilt_one` are the same filter
@@ -198,6 +200,54 @@ def sosfiltfilt_inplace(e, f, pad, sos, zi):  # type: ignore[no-untyped-def]
         biquad_pass(e, f, m - 1, -1, -1, sos[s], zi[s, 0] * ye, zi[s, 1] * ye, zi[s, 0] * yf, zi[s, 1] * yf)
 
 
+@jit
+def biquad_pass4(e, f, g, h, start, stop, step, section, ze0, ze1, zf0, zf1, zg0, zg1, zh0, zh1):  # type: ignore[no-untyped-def]
+    """`biquad_pass` over four signals interleaved (each signal's operations `biquad_pass`'s, in
+    its order): four dependency chains overlap where two left the core waiting."""
+    b0, b1, b2, a1, a2 = section[0], section[1], section[2], section[4], section[5]
+    for k in range(start, stop, step):
+        x = e[k]
+        y = b0 * x + ze0
+        ze0 = b1 * x - a1 * y + ze1
+        ze1 = b2 * x - a2 * y
+        e[k] = y
+        x = f[k]
+        y = b0 * x + zf0
+        zf0 = b1 * x - a1 * y + zf1
+        zf1 = b2 * x - a2 * y
+        f[k] = y
+        x = g[k]
+        y = b0 * x + zg0
+        zg0 = b1 * x - a1 * y + zg1
+        zg1 = b2 * x - a2 * y
+        g[k] = y
+        x = h[k]
+        y = b0 * x + zh0
+        zh0 = b1 * x - a1 * y + zh1
+        zh1 = b2 * x - a2 * y
+        h[k] = y
+
+
+@jit
+def sosfiltfilt_inplace4(e, f, g, h, pad, sos, zi):  # type: ignore[no-untyped-def]
+    """`sosfiltfilt_inplace` for four signals of one length at once (`biquad_pass4`): each
+    signal's numbers those of `sosfiltfilt_inplace`."""
+    m = e.shape[0]
+    odd_extend(e, pad)
+    odd_extend(f, pad)
+    odd_extend(g, pad)
+    odd_extend(h, pad)
+    xe, xf, xg, xh = e[0], f[0], g[0], h[0]
+    for s in range(sos.shape[0]):  # forward, every state started at zi·(first sample)
+        z0, z1 = zi[s, 0], zi[s, 1]
+        biquad_pass4(e, f, g, h, 0, m, 1, sos[s], z0 * xe, z1 * xe, z0 * xf, z1 * xf, z0 * xg, z1 * xg, z0 * xh, z1 * xh)
+    ye, yf, yg, yh = e[m - 1], f[m - 1], g[m - 1], h[m - 1]
+    for s in range(sos.shape[0]):  # backward, started at zi·(last forward output)
+        z0, z1 = zi[s, 0], zi[s, 1]
+        biquad_pass4(e, f, g, h, m - 1, -1, -1, sos[s], z0 * ye, z1 * ye, z0 * yf, z1 * yf, z0 * yg, z1 * yg,
+                     z0 * yh, z1 * yh)  # fmt: skip
+
+
 def sosfiltfilt_one(x: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int, out: np.ndarray) -> None:
     """``out = sosfiltfilt(sos, x)`` for one signal x (n > pad), serially: the numbers of
     `sosfiltfilt_many`'s rows (paired with a zero signal), without a parallel launch."""
@@ -279,6 +329,22 @@ def filtered_fitness(e, f, pad, sos, zi, ref, weights, stack):  # type: ignore[n
 
 
 @jit
+def filtered_fitness4(e, f, g, h, pad, sos, zi, ref, weights, stack):  # type: ignore[no-untyped-def]
+    """`filtered_fitness` of four currents at once (their filters interleaved,
+    `sosfiltfilt_inplace4`): each one's number `filtered_fitness`'s."""
+    n = e.shape[0] - 2 * pad
+    finite = (all_finite(e, pad, pad + n), all_finite(f, pad, pad + n), all_finite(g, pad, pad + n),
+              all_finite(h, pad, pad + n))  # fmt: skip
+    sosfiltfilt_inplace4(e, f, g, h, pad, sos, zi)
+    return (
+        weighted_sum(e, pad, ref, weights, stack) if finite[0] else np.nan,
+        weighted_sum(f, pad, ref, weights, stack) if finite[1] else np.nan,
+        weighted_sum(g, pad, ref, weights, stack) if finite[2] else np.nan,
+        weighted_sum(h, pad, ref, weights, stack) if finite[3] else np.nan,
+    )
+
+
+@jit
 def simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux):  # type: ignore[no-untyped-def]
     """LF runs of rows r and, with `pair`, r + 1 of `prm` into buf (2 rows of len(theta_cmd) + 2·pad
     samples), each current at [pad, pad + n) (the pads are the filter's to fill); without `pair`
@@ -295,12 +361,13 @@ def simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux):  # type: ignore[no
 def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int | None) -> tuple[int, np.ndarray, int, np.ndarray]:
     """What a fused kernel's call takes besides its data: the thread count (default numba's,
     ``numba.get_num_threads()``, asked here: a kernel that asks numba itself cannot be cached), the
-    batch's plan (`batches.batch_plan`) and a buffer of 2 × (n + 2·pad) per thread. Allocated
+    batch's plan (`batches.batch_plan`) and a buffer of 4 × (n + 2·pad) per thread (two pairs'
+    currents, filtered at once). Allocated
     here, not in the kernels: a kernel that allocates loads with numba's array module
     (`STACK_SIZE`'s note)."""
     n_threads = get_num_threads() if n_threads is None else int(n_threads)
     owner, n_pairs = batch_plan(prm.shape[0], n_threads)
-    return n_threads, owner, n_pairs, np.empty((max(n_threads, 1), 2, n + 2 * pad))
+    return n_threads, owner, n_pairs, np.empty((max(n_threads, 1), 4, n + 2 * pad))
 
 
 def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
@@ -322,17 +389,32 @@ def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi:
 @jit(parallel=True)
 def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, no_aux):  # type: ignore[no-untyped-def]
     """`fitness_lf_many` with its plan and buffers (`_buffers`): thread t runs the tasks
-    owner gives it in work[t], with stacks[t]."""
+    owner gives it in work[t], with stacks[t]; two of its pairs' currents are filtered at once
+    (`filtered_fitness4`), a pair left over and a row alone as before (`filtered_fitness`)."""
     for t in prange(max(n_threads, 1)):  # the plan's threads are 0 … max(n_threads, 1) − 1
         buf = work[t]
+        held = -1  # the first row of a pair run into buf[0:2] that waits for a second pair
         for task in range(owner.shape[0]):
-            if owner[task] == t:
-                r, pair = planned_task(task, n_pairs)
-                simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux)
-                fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
-                out[r] = fit_0
-                if pair:
-                    out[r + 1] = fit_1
+            if owner[task] != t:
+                continue
+            r, pair = planned_task(task, n_pairs)
+            if pair and held < 0:
+                simulate_pair(theta_cmd, prm, r, True, pad, buf[0:2], no_aux)
+                held = r
+            elif pair:
+                simulate_pair(theta_cmd, prm, r, True, pad, buf[2:4], no_aux)
+                out[held], out[held + 1], out[r], out[r + 1] = filtered_fitness4(
+                    buf[0], buf[1], buf[2], buf[3], pad, sos, zi, ref, weights, stacks[t]
+                )
+                held = -1
+            else:  # a row alone: after the thread's pairs (`batches.planned_task`)
+                if held >= 0:
+                    out[held], out[held + 1] = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
+                    held = -1
+                simulate_pair(theta_cmd, prm, r, False, pad, buf[0:2], no_aux)
+                out[r], _ = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
+        if held >= 0:
+            out[held], out[held + 1] = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
 
 
 def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
@@ -354,17 +436,44 @@ def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, z
 
 @jit(parallel=True)
 def residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, no_aux):  # type: ignore[no-untyped-def]
-    """`residuals_lf_many` with its plan and buffers (`_buffers`)."""
+    """`residuals_lf_many` with its plan and buffers (`_buffers`), two pairs' currents filtered at
+    once as in `fitness_lf_kernel`."""
     for t in prange(max(n_threads, 1)):
         buf = work[t]
+        held = -1
         for task in range(owner.shape[0]):
-            if owner[task] == t:
-                r, pair = planned_task(task, n_pairs)
-                simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux)
-                sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-                kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
-                if pair:
-                    kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
+            if owner[task] != t:
+                continue
+            r, pair = planned_task(task, n_pairs)
+            if pair and held < 0:
+                simulate_pair(theta_cmd, prm, r, True, pad, buf[0:2], no_aux)
+                held = r
+                continue
+            if pair:
+                simulate_pair(theta_cmd, prm, r, True, pad, buf[2:4], no_aux)
+                sosfiltfilt_inplace4(buf[0], buf[1], buf[2], buf[3], pad, sos, zi)
+                kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[held])
+                kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[held + 1])
+                kept_residuals(buf[2], pad, keep, ref_keep, root_w, out[r])
+                kept_residuals(buf[3], pad, keep, ref_keep, root_w, out[r + 1])
+                held = -1
+                continue
+            if held >= 0:  # a row alone comes after the thread's pairs
+                residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, held, True)
+                held = -1
+            simulate_pair(theta_cmd, prm, r, False, pad, buf[0:2], no_aux)
+            residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, r, False)
+        if held >= 0:
+            residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, held, True)
+
+
+@jit
+def residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, r, pair):  # type: ignore[no-untyped-def]
+    """Filter buf[0] and buf[1] together; the residuals of row r (and r + 1 with `pair`) into out."""
+    sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+    kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
+    if pair:
+        kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
 
 
 @jit
