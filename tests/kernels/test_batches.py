@@ -4,7 +4,7 @@ plans' loads, and the same numbers whatever the plan."""
 import numpy as np
 import pytest
 
-from emaphm.kernels.batches import PAIR_COST, batch_plan
+from emaphm.kernels.batches import PAIR, PAIR_COST, QUAD, SINGLE, batch_plan, thread_jobs
 from emaphm.kernels.fitness import fitness_lf_many, residuals_lf_many
 
 from .test_fitness_kernel import population
@@ -65,3 +65,22 @@ def test_the_kernels_give_the_same_numbers_whatever_the_plan(n_threads):
             residuals_lf_many(theta_cmd, rows[r : r + 1], f.sos, f.zi, f.padlen, keep, f.comparison.reference[keep],
                               np.sqrt(f.weights[keep]), alone, 1)  # fmt: skip
             np.testing.assert_array_equal(alone[0], res_ref[r])
+
+
+def test_each_thread_runs_its_planned_rows_once_two_pairs_at_a_time():
+    for n_threads in (1, 2, 3):
+        for n_runs in range(1, 40):
+            owner, n_pairs = batch_plan(n_runs, n_threads)
+            jobs = thread_jobs(n_runs, n_threads)
+            seen = []
+            for t in range(jobs.shape[0]):
+                kinds = [int(k) for k in jobs[t, :, 0] if k]
+                assert jobs[t, len(kinds):, 0].sum() == 0  # the list ends with its first empty job
+                assert kinds == sorted(kinds, reverse=True)  # quads, then a pair left over, then rows alone
+                assert kinds.count(PAIR) <= 1
+                for kind, a, b in jobs[t, : len(kinds)]:
+                    rows = {QUAD: [a, a + 1, b, b + 1], PAIR: [a, a + 1], SINGLE: [a]}[int(kind)]
+                    task_of = [r // 2 if r < 2 * n_pairs else r - n_pairs for r in rows]
+                    assert all(owner[q] == t for q in task_of)  # the plan's thread
+                    seen += rows
+            assert sorted(seen) == list(range(n_runs)), (n_runs, n_threads)

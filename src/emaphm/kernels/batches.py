@@ -21,8 +21,6 @@ import math
 
 import numpy as np
 
-from ._jit import jit
-
 # a pair of rows on one thread, in single rows' time (machine G: 1.06-1.22 / 0.65-0.77 ms; E: 1.2-1.6)
 PAIR_COST = 1.7
 
@@ -64,9 +62,49 @@ def _plan(n_runs: int, n_threads: int) -> tuple[np.ndarray, int]:
     return owner, best_pairs
 
 
-@jit(inline=True)
-def planned_task(task, n_pairs):  # type: ignore[no-untyped-def]
+# a thread's job (`thread_jobs`): none (the end of its list), a row alone, a pair, two pairs
+NONE, SINGLE, PAIR, QUAD = 0, 1, 2, 4
+
+
+def planned_task(task: int, n_pairs: int) -> tuple[int, bool]:
     """Task `task` of a `batch_plan` with `n_pairs` pairs: (its first row, whether it is a pair)."""
     pair = task < n_pairs
     return (2 * task if pair else n_pairs + task), pair
 
+
+def thread_jobs(n_runs: int, n_threads: int) -> np.ndarray:
+    """`batch_plan` as each thread's jobs, in order: jobs[t, j] = (kind, a, b), `QUAD` the pairs
+    from rows a and b (their four currents filtered at once), `PAIR` rows a and a + 1, `SINGLE`
+    row a, `NONE` the end of thread t's list; t runs 0 … max(n_threads, 1) − 1. Two of a thread's
+    pairs make a quad, a pair left over stays a pair (a thread's rows alone come after its pairs).
+    Which job runs a row does not change its numbers. A read-only array, cached per batch size and
+    thread count."""
+    return _jobs(int(n_runs), int(n_threads))
+
+
+@functools.lru_cache(maxsize=512)
+def _jobs(n_runs: int, n_threads: int) -> np.ndarray:
+    owner, n_pairs = _plan(n_runs, n_threads)
+    lists: list[list[tuple[int, int, int]]] = [[] for _ in range(max(n_threads, 1))]
+    held = [-1] * len(lists)  # a pair that waits for a second one
+    for task, t in enumerate(owner.tolist()):
+        r, pair = planned_task(task, n_pairs)
+        if pair and held[t] < 0:
+            held[t] = r
+            continue
+        if pair:
+            lists[t].append((QUAD, held[t], r))
+        else:
+            if held[t] >= 0:
+                lists[t].append((PAIR, held[t], 0))
+            lists[t].append((SINGLE, r, 0))
+        held[t] = -1
+    for t, r in enumerate(held):
+        if r >= 0:
+            lists[t].append((PAIR, r, 0))
+    jobs = np.zeros((len(lists), max(1, *map(len, lists)), 3), dtype=np.int64)
+    for t, items in enumerate(lists):
+        if items:
+            jobs[t, : len(items)] = items
+    jobs.flags.writeable = False
+    return jobs

@@ -36,7 +36,7 @@ import numpy as np
 from numba import get_num_threads, prange
 
 from ._jit import jit
-from .batches import batch_plan, planned_task
+from .batches import PAIR, QUAD, thread_jobs
 from .monitor import NO_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
@@ -144,26 +144,23 @@ def pairwise_sum_into(a, lo, n, stack):  # type: ignore[no-untyped-def]
             val = f_left[d] + val
 
 
+@jit(inline=True)
+def biquad_step(x, b0, b1, b2, a1, a2, z0, z1):  # type: ignore[no-untyped-def]
+    """One sample x through a second-order section (b0, b1, b2, 1, a1, a2) in direct form II
+    transposed with the state (z0, z1): scipy's `_sosfilt`. Returns (y, new z0, new z1)."""
+    y = b0 * x + z0
+    return y, b1 * x - a1 * y + z1, b2 * x - a2 * y
+
+
 @jit
 def biquad_pass(e, f, start, stop, step, section, ze0, ze1, zf0, zf1):  # type: ignore[no-untyped-def]
     """One second-order section (b0, b1, b2, 1, a1, a2) over e[start], e[start+step], … (not
     e[stop]), in place, and the same over f: two independent signals, interleaved so that their
-    dependency chains overlap.
-
-    Direct form II transposed with initial states (ze0, ze1) and (zf0, zf1): scipy's `_sosfilt`.
-    """
+    dependency chains overlap (`biquad_step`), with initial states (ze0, ze1) and (zf0, zf1)."""
     b0, b1, b2, a1, a2 = section[0], section[1], section[2], section[4], section[5]
     for k in range(start, stop, step):
-        x = e[k]
-        y = b0 * x + ze0
-        ze0 = b1 * x - a1 * y + ze1
-        ze1 = b2 * x - a2 * y
-        e[k] = y
-        x = f[k]
-        y = b0 * x + zf0
-        zf0 = b1 * x - a1 * y + zf1
-        zf1 = b2 * x - a2 * y
-        f[k] = y
+        e[k], ze0, ze1 = biquad_step(e[k], b0, b1, b2, a1, a2, ze0, ze1)
+        f[k], zf0, zf1 = biquad_step(f[k], b0, b1, b2, a1, a2, zf0, zf1)
 
 
 @jit
@@ -202,30 +199,14 @@ def sosfiltfilt_inplace(e, f, pad, sos, zi):  # type: ignore[no-untyped-def]
 
 @jit
 def biquad_pass4(e, f, g, h, start, stop, step, section, ze0, ze1, zf0, zf1, zg0, zg1, zh0, zh1):  # type: ignore[no-untyped-def]
-    """`biquad_pass` over four signals interleaved (each signal's operations `biquad_pass`'s, in
+    """`biquad_pass` over four signals interleaved (each signal's operations `biquad_step`'s, in
     its order): four dependency chains overlap where two left the core waiting."""
     b0, b1, b2, a1, a2 = section[0], section[1], section[2], section[4], section[5]
     for k in range(start, stop, step):
-        x = e[k]
-        y = b0 * x + ze0
-        ze0 = b1 * x - a1 * y + ze1
-        ze1 = b2 * x - a2 * y
-        e[k] = y
-        x = f[k]
-        y = b0 * x + zf0
-        zf0 = b1 * x - a1 * y + zf1
-        zf1 = b2 * x - a2 * y
-        f[k] = y
-        x = g[k]
-        y = b0 * x + zg0
-        zg0 = b1 * x - a1 * y + zg1
-        zg1 = b2 * x - a2 * y
-        g[k] = y
-        x = h[k]
-        y = b0 * x + zh0
-        zh0 = b1 * x - a1 * y + zh1
-        zh1 = b2 * x - a2 * y
-        h[k] = y
+        e[k], ze0, ze1 = biquad_step(e[k], b0, b1, b2, a1, a2, ze0, ze1)
+        f[k], zf0, zf1 = biquad_step(f[k], b0, b1, b2, a1, a2, zf0, zf1)
+        g[k], zg0, zg1 = biquad_step(g[k], b0, b1, b2, a1, a2, zg0, zg1)
+        h[k], zh0, zh1 = biquad_step(h[k], b0, b1, b2, a1, a2, zh0, zh1)
 
 
 @jit
@@ -358,16 +339,29 @@ def simulate_pair(theta_cmd, prm, r, pair, pad, buf, no_aux):  # type: ignore[no
             buf[1, k] = 0.0
 
 
-def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int | None) -> tuple[int, np.ndarray, int, np.ndarray]:
-    """What a fused kernel's call takes besides its data: the thread count (default numba's,
-    ``numba.get_num_threads()``, asked here: a kernel that asks numba itself cannot be cached), the
-    batch's plan (`batches.batch_plan`) and a buffer of 4 × (n + 2·pad) per thread (two pairs'
-    currents, filtered at once). Allocated
-    here, not in the kernels: a kernel that allocates loads with numba's array module
-    (`STACK_SIZE`'s note)."""
+def _buffers(prm: np.ndarray, n: int, pad: int, n_threads: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """What a fused kernel's call takes besides its data: each thread's jobs
+    (`batches.thread_jobs` for numba's thread count, ``numba.get_num_threads()``, asked here: a
+    kernel that asks numba itself cannot be cached) and a buffer of 4 × (n + 2·pad) per thread
+    (two pairs' currents, filtered at once). Allocated here, not in the kernels: a kernel that
+    allocates loads with numba's array module (`STACK_SIZE`'s note)."""
     n_threads = get_num_threads() if n_threads is None else int(n_threads)
-    owner, n_pairs = batch_plan(prm.shape[0], n_threads)
-    return n_threads, owner, n_pairs, np.empty((max(n_threads, 1), 4, n + 2 * pad))
+    jobs = thread_jobs(prm.shape[0], n_threads)
+    return jobs, np.empty((jobs.shape[0], 4, n + 2 * pad))
+
+
+@jit
+def run_job(theta_cmd, prm, pad, buf, job, no_aux):  # type: ignore[no-untyped-def]
+    """The monitor runs of one job (`batches.thread_jobs`) into buf (4 rows of len(theta_cmd) +
+    2·pad): a quad's two pairs in rows 0-1 and 2-3, a pair or a row alone (beside zeros) in rows
+    0-1 (`simulate_pair`). Returns the job (kind, a, b)."""
+    kind, a, b = job[0], job[1], job[2]
+    if kind == QUAD:
+        simulate_pair(theta_cmd, prm, a, True, pad, buf[0:2], no_aux)
+        simulate_pair(theta_cmd, prm, b, True, pad, buf[2:4], no_aux)
+    elif kind != 0:
+        simulate_pair(theta_cmd, prm, a, kind == PAIR, pad, buf[0:2], no_aux)
+    return kind, a, b
 
 
 def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
@@ -381,40 +375,28 @@ def fitness_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi:
     filtered beside a zero signal. `n_threads`: the threads numba runs it on (default
     ``numba.get_num_threads()``).
     """
-    n_threads, owner, n_pairs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
-    stacks = stack_for(n_threads)
-    fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, NO_AUX)
+    jobs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, jobs, work, stack_for(jobs.shape[0]), NO_AUX)
 
 
 @jit(parallel=True)
-def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, n_threads, owner, n_pairs, work, stacks, no_aux):  # type: ignore[no-untyped-def]
-    """`fitness_lf_many` with its plan and buffers (`_buffers`): thread t runs the tasks
-    owner gives it in work[t], with stacks[t]; two of its pairs' currents are filtered at once
-    (`filtered_fitness4`), a pair left over and a row alone as before (`filtered_fitness`)."""
-    for t in prange(max(n_threads, 1)):  # the plan's threads are 0 … max(n_threads, 1) − 1
+def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, jobs, work, stacks, no_aux):  # type: ignore[no-untyped-def]
+    """`fitness_lf_many` with its jobs and buffers (`_buffers`): thread t runs jobs[t] in work[t],
+    with stacks[t]; a quad's four currents are filtered at once (`filtered_fitness4`), a pair's
+    two or a row alone beside zeros (`filtered_fitness`)."""
+    for t in prange(jobs.shape[0]):
         buf = work[t]
-        held = -1  # the first row of a pair run into buf[0:2] that waits for a second pair
-        for task in range(owner.shape[0]):
-            if owner[task] != t:
-                continue
-            r, pair = planned_task(task, n_pairs)
-            if pair and held < 0:
-                simulate_pair(theta_cmd, prm, r, True, pad, buf[0:2], no_aux)
-                held = r
-            elif pair:
-                simulate_pair(theta_cmd, prm, r, True, pad, buf[2:4], no_aux)
-                out[held], out[held + 1], out[r], out[r + 1] = filtered_fitness4(
+        for j in range(jobs.shape[1]):
+            kind, a, b = run_job(theta_cmd, prm, pad, buf, jobs[t, j], no_aux)
+            if kind == QUAD:
+                out[a], out[a + 1], out[b], out[b + 1] = filtered_fitness4(
                     buf[0], buf[1], buf[2], buf[3], pad, sos, zi, ref, weights, stacks[t]
                 )
-                held = -1
-            else:  # a row alone: after the thread's pairs (`batches.planned_task`)
-                if held >= 0:
-                    out[held], out[held + 1] = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
-                    held = -1
-                simulate_pair(theta_cmd, prm, r, False, pad, buf[0:2], no_aux)
-                out[r], _ = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
-        if held >= 0:
-            out[held], out[held + 1] = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
+            elif kind != 0:
+                fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
+                out[a] = fit_0
+                if kind == PAIR:
+                    out[a + 1] = fit_1
 
 
 def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, zi: np.ndarray, pad: int,
@@ -430,50 +412,27 @@ def residuals_lf_many(theta_cmd: np.ndarray, prm: np.ndarray, sos: np.ndarray, z
     `monitor.simulate_lf_many` by `sosfiltfilt_many` and taking the residual in numpy. A row whose
     LF current is not finite gets NaN residuals. `n_threads` as in `fitness_lf_many`.
     """
-    n_threads, owner, n_pairs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
-    residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, NO_AUX)
+    jobs, work = _buffers(prm, theta_cmd.shape[0], pad, n_threads)
+    residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, jobs, work, NO_AUX)
 
 
 @jit(parallel=True)
-def residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, n_threads, owner, n_pairs, work, no_aux):  # type: ignore[no-untyped-def]
-    """`residuals_lf_many` with its plan and buffers (`_buffers`), two pairs' currents filtered at
-    once as in `fitness_lf_kernel`."""
-    for t in prange(max(n_threads, 1)):
+def residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, out, jobs, work, no_aux):  # type: ignore[no-untyped-def]
+    """`residuals_lf_many` with its jobs and buffers (`_buffers`), a quad's four currents filtered
+    at once as in `fitness_lf_kernel`."""
+    for t in prange(jobs.shape[0]):
         buf = work[t]
-        held = -1
-        for task in range(owner.shape[0]):
-            if owner[task] != t:
-                continue
-            r, pair = planned_task(task, n_pairs)
-            if pair and held < 0:
-                simulate_pair(theta_cmd, prm, r, True, pad, buf[0:2], no_aux)
-                held = r
-                continue
-            if pair:
-                simulate_pair(theta_cmd, prm, r, True, pad, buf[2:4], no_aux)
+        for j in range(jobs.shape[1]):
+            kind, a, b = run_job(theta_cmd, prm, pad, buf, jobs[t, j], no_aux)
+            if kind == QUAD:
                 sosfiltfilt_inplace4(buf[0], buf[1], buf[2], buf[3], pad, sos, zi)
-                kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[held])
-                kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[held + 1])
-                kept_residuals(buf[2], pad, keep, ref_keep, root_w, out[r])
-                kept_residuals(buf[3], pad, keep, ref_keep, root_w, out[r + 1])
-                held = -1
-                continue
-            if held >= 0:  # a row alone comes after the thread's pairs
-                residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, held, True)
-                held = -1
-            simulate_pair(theta_cmd, prm, r, False, pad, buf[0:2], no_aux)
-            residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, r, False)
-        if held >= 0:
-            residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, held, True)
-
-
-@jit
-def residuals_of_pair(buf, pad, sos, zi, keep, ref_keep, root_w, out, r, pair):  # type: ignore[no-untyped-def]
-    """Filter buf[0] and buf[1] together; the residuals of row r (and r + 1 with `pair`) into out."""
-    sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
-    kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[r])
-    if pair:
-        kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[r + 1])
+                for q, r in enumerate((a, a + 1, b, b + 1)):
+                    kept_residuals(buf[q], pad, keep, ref_keep, root_w, out[r])
+            elif kind != 0:
+                sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
+                kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[a])
+                if kind == PAIR:
+                    kept_residuals(buf[1], pad, keep, ref_keep, root_w, out[a + 1])
 
 
 @jit
