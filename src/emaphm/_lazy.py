@@ -1,12 +1,16 @@
-"""Names a package imports on first use (PEP 562), so that importing it stays cheap."""
+"""Names a package imports on first use (PEP 562), so that importing it stays cheap; a
+dependency imported without the modules it loads for nothing (`imports_without`)."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib
-from collections.abc import Callable, Mapping
+import sys
+import types
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from typing import Any
 
-__all__ = ["lazy_names"]
+__all__ = ["imports_without", "lazy_names"]
 
 
 def lazy_names(
@@ -27,3 +31,27 @@ def lazy_names(
         return sorted({*namespace, *where})
 
     return __getattr__, __dir__
+
+
+@contextlib.contextmanager
+def imports_without(blocked: Iterable[str], stand_ins: Mapping[str, types.ModuleType] | None = None) -> Iterator[None]:
+    """While the block imports: each module of `blocked` not loaded yet unimportable (None in
+    ``sys.modules``, which an optional import catches as ImportError), each of `stand_ins` not
+    loaded yet stood in for by its object; afterwards both taken out again, so that anyone imports
+    the real modules (what the block's imports bound keeps the stand-in). For a dependency's
+    import that loads modules a command never uses (`identification.cmaes`, `_lean_numba`); the
+    caller makes sure no other thread imports meanwhile."""
+    absent = [name for name in blocked if name not in sys.modules]
+    stood = {name: module for name, module in (stand_ins or {}).items() if name not in sys.modules}
+    for name in absent:
+        sys.modules[name] = None  # type: ignore[assignment]
+    sys.modules.update(stood)
+    try:
+        yield
+    finally:
+        for name in absent:
+            if name in sys.modules and sys.modules[name] is None:
+                del sys.modules[name]
+        for name, module in stood.items():
+            if sys.modules.get(name) is module:
+                del sys.modules[name]

@@ -23,6 +23,7 @@ import sys
 import types
 from typing import Any
 
+from ._lazy import imports_without
 from ._threads import others_run
 
 __all__ = ["NUMBA_CONFIG_FILE", "NUMBA_UNUSED_IMPORTS", "extensions_declared", "import_numba"]
@@ -42,20 +43,8 @@ def import_numba() -> None:
         importlib.import_module("numba")
         return
     unused = [n for n in NUMBA_UNUSED_IMPORTS if not (n == "yaml" and os.path.isfile(NUMBA_CONFIG_FILE))]
-    blocked = [name for name in unused if name not in sys.modules]
-    stand_in = _LazyModule(METADATA) if METADATA not in sys.modules else None
-    for name in blocked:
-        sys.modules[name] = None  # type: ignore[assignment]
-    if stand_in is not None:
-        sys.modules[METADATA] = stand_in
-    try:
+    with imports_without(unused, {METADATA: _LazyModule(METADATA)}):
         importlib.import_module("numba")
-    finally:
-        for name in blocked:
-            if name in sys.modules and sys.modules[name] is None:
-                del sys.modules[name]
-        if stand_in is not None and sys.modules.get(METADATA) is stand_in:
-            del sys.modules[METADATA]
     entrypoints = sys.modules.get("numba.core.entrypoints")
     if entrypoints is not None and hasattr(entrypoints, "_already_initialized") and not extensions_declared():
         entrypoints._already_initialized = True  # nothing to load: numba's scan would find none

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._lazy import imports_without
 from .._threads import others_run as _others_run
 from .ga import Termination
 from .optimizers import BatchProblem, GenerationLog, OnGeneration, Stagnation
@@ -88,22 +89,11 @@ def _lean_imports(*, moocore: bool) -> Iterator[None]:
     if "cma" in sys.modules or _others_run():
         yield
         return
-    blocked = [name for name in CMA_UNUSED_IMPORTS if name not in sys.modules]
-    for name in blocked:
-        sys.modules[name] = None  # type: ignore[assignment]
-    stand_in = _LazyMoocore("moocore") if moocore and "moocore" not in sys.modules else None
-    if stand_in is not None:
-        sys.modules["moocore"] = stand_in
+    stand_ins = {"moocore": _LazyMoocore("moocore")} if moocore else {}
     # cma's "Could not import matplotlib.pyplot, therefore ``cma.plot()`` etc. is not available"
     warnings.filterwarnings("ignore", message="Could not import matplotlib", category=UserWarning)
-    try:
+    with imports_without(CMA_UNUSED_IMPORTS, stand_ins):
         yield
-    finally:
-        for name in blocked:
-            if name in sys.modules and sys.modules[name] is None:
-                del sys.modules[name]
-        if stand_in is not None and sys.modules.get("moocore") is stand_in:
-            del sys.modules["moocore"]
 
 
 class _LazyMoocore(types.ModuleType):

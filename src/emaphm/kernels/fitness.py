@@ -36,7 +36,7 @@ import numpy as np
 from numba import get_num_threads, prange
 
 from ._jit import jit
-from .batches import PAIR, QUAD, thread_jobs
+from .batches import NONE, PAIR, QUAD, thread_jobs
 from .monitor import NO_AUX, simulate_lf, simulate_lf2
 
 PW_BLOCKSIZE = 128  # numpy's pairwise-summation block (PW_BLOCKSIZE in loops_utils.h.src)
@@ -359,7 +359,7 @@ def run_job(theta_cmd, prm, pad, buf, job, no_aux):  # type: ignore[no-untyped-d
     if kind == QUAD:
         simulate_pair(theta_cmd, prm, a, True, pad, buf[0:2], no_aux)
         simulate_pair(theta_cmd, prm, b, True, pad, buf[2:4], no_aux)
-    elif kind != 0:
+    elif kind != NONE:
         simulate_pair(theta_cmd, prm, a, kind == PAIR, pad, buf[0:2], no_aux)
     return kind, a, b
 
@@ -392,7 +392,7 @@ def fitness_lf_kernel(theta_cmd, prm, sos, zi, pad, ref, weights, out, jobs, wor
                 out[a], out[a + 1], out[b], out[b + 1] = filtered_fitness4(
                     buf[0], buf[1], buf[2], buf[3], pad, sos, zi, ref, weights, stacks[t]
                 )
-            elif kind != 0:
+            elif kind != NONE:
                 fit_0, fit_1 = filtered_fitness(buf[0], buf[1], pad, sos, zi, ref, weights, stacks[t])
                 out[a] = fit_0
                 if kind == PAIR:
@@ -428,7 +428,7 @@ def residuals_lf_kernel(theta_cmd, prm, sos, zi, pad, keep, ref_keep, root_w, ou
                 sosfiltfilt_inplace4(buf[0], buf[1], buf[2], buf[3], pad, sos, zi)
                 for q, r in enumerate((a, a + 1, b, b + 1)):
                     kept_residuals(buf[q], pad, keep, ref_keep, root_w, out[r])
-            elif kind != 0:
+            elif kind != NONE:
                 sosfiltfilt_inplace(buf[0], buf[1], pad, sos, zi)
                 kept_residuals(buf[0], pad, keep, ref_keep, root_w, out[a])
                 if kind == PAIR:
