@@ -24,6 +24,10 @@ Prints, each as the median (min-max) over --repeats:
    case): each of its three runs alone, the three one after the other, the three on two threads
    as the last stage runs them, and one run (the finest step) alone against two of it side by
    side on two threads: what the two cores give two runs of compiled code at once.
+10. (eighteenth session) the comparison filter on four currents of 10 001 samples: as two
+    interleaved pairs (`sosfiltfilt_inplace` twice) and all four at once (`sosfiltfilt_inplace4`);
+11. (eighteenth session) the start table's ranking of the Table 1 case (`StartTable.ranked`) on one
+    numba thread and on two.
 Run on an older tree (``PYTHONPATH=<worktree>/src``) it times what that tree has: no events'
 block, no `gram`, the fused kernel without its thread count (then its pairs alone).
 Not a benchmark of the whole process: the paired figures are `farm-bench`'s.
@@ -209,6 +213,7 @@ def main(argv: list[str] | None = None) -> None:
     for name, way in runs.items():
         print(f"6. the monitor, {name}: {spread(per_call(way, args.repeats, 50))} ms")
     switching_runs(args.repeats)
+    filter_and_ranking(args.repeats)
     if hasattr(_jit, "LAZY_LINKING"):
         for mode in ("on", "off"):
             runs = np.array([[float(v) for v in fresh(LOADS_LAZY, mode)] for _ in range(args.repeats)])
@@ -244,6 +249,41 @@ def switching_runs(repeats: int) -> None:
     with ThreadPoolExecutor(2) as pool:
         pair = per_call(lambda: list(pool.map(lambda _: finest(), range(2))), repeats, 1)
     print(f"8. the finest step's run, two side by side on two threads: {spread(pair)} ms")
+
+
+
+
+def filter_and_ranking(repeats: int) -> None:
+    """Items 10 and 11: four currents filtered as two pairs and at once; the table's ranking on one
+    numba thread and on two (where the tree has them)."""
+    import numba
+
+    from emaphm.identification import api, start_table
+    from emaphm.identification.signals import comparison_filter
+    from emaphm.kernels import fitness
+
+    if hasattr(fitness, "sosfiltfilt_inplace4"):
+        sos, zi, pad = comparison_filter(10_000.0)
+        X = np.random.default_rng(0).normal(size=(4, 10_001 + 2 * pad)).cumsum(axis=1)
+        A = X.copy()
+        ways = {"two pairs": lambda: (fitness.sosfiltfilt_inplace(A[0], A[1], pad, sos, zi),
+                                      fitness.sosfiltfilt_inplace(A[2], A[3], pad, sos, zi)),
+                "four at once": lambda: fitness.sosfiltfilt_inplace4(A[0], A[1], A[2], A[3], pad, sos, zi)}  # fmt: skip
+        for name, way in ways.items():
+            print(f"10. the filter, 4 currents as {name}: {spread(per_call(way, repeats, 200), 1e6)} us")
+    seen = []
+    original = start_table.StartTable.ranked
+    start_table.StartTable.ranked = lambda self, *a: seen.append((self, a)) or original(self, *a)
+    try:
+        api.identify(TABLE1, seed=1, uncertainty="none")
+    finally:
+        start_table.StartTable.ranked = original
+    table, call = seen[0]
+    threads = numba.get_num_threads()
+    for n in (1, threads):
+        numba.set_num_threads(n)
+        print(f"11. the start table's ranking on {n} numba thread(s): {spread(per_call(lambda: original(table, *call), repeats, 20))} ms")
+    numba.set_num_threads(threads)
 
 
 if __name__ == "__main__":
